@@ -1,0 +1,21 @@
+#pragma once
+// The hybridctl subcommands. Each registers itself on the CLI11 app and runs when
+// chosen; a run returns the process exit code.
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+
+namespace hybridctl::cli {
+
+// Exit codes, documented in `hybridctl --help` and the README.
+enum ExitCode : int { kSuccess = 0, kInternalError = 1, kUsage = 2, kBadInput = 3 };
+
+using Runner = std::function<int()>;
+
+// Each adds its subcommand to `app` and returns what runs it.
+void add_machine_command(CLI::App& app, Runner& runner);
+void add_voxelize_command(CLI::App& app, Runner& runner);
+void add_inspect_command(CLI::App& app, Runner& runner);
+
+}  // namespace hybridctl::cli

@@ -1,0 +1,37 @@
+// hybridctl: plans and runs hybrid (additive + subtractive) manufacturing.
+
+#include <cstdio>
+#include <exception>
+
+#include "cli/commands.hpp"
+#include "common/error.hpp"
+
+int main(int argc, char** argv) {
+  using namespace hybridctl::cli;
+  CLI::App app{
+      "hybridctl plans hybrid manufacturing (metal deposition and milling on one machine)\n"
+      "from a part (STL) and a machine description (YAML).\n\n"
+      "Exit codes: 0 success, 1 internal error, 2 usage error, 3 bad input (file, YAML, STL).",
+      "hybridctl"};
+  app.set_version_flag("--version", "hybridctl 0.1.0");
+  app.require_subcommand(1);
+  Runner runner;
+  add_machine_command(app, runner);
+  add_voxelize_command(app, runner);
+  add_inspect_command(app, runner);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? kSuccess : kUsage;
+  }
+  try {
+    return runner ? runner() : kUsage;
+  } catch (const hybridctl::InputError& e) {
+    std::fprintf(stderr, "hybridctl: error: %s\n", e.what());
+    return kBadInput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "hybridctl: internal error: %s\n", e.what());
+    return kInternalError;
+  }
+}
