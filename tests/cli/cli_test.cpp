@@ -1,0 +1,168 @@
+// The hybridctl program as a user meets it: exit codes (0 success, 2 usage, 3 bad
+// input), messages on stderr that say where and what was expected, help everywhere,
+// and no output file left behind when something fails.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "geometry/mesh.hpp"
+#include "geometry/vdb_file.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Run {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("hybridctl-cli-" + std::to_string(::getpid()) + "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Run run(const std::vector<std::string>& args) {
+    std::string cmd = quote(HYBRIDCTL_EXE);
+    for (const auto& a : args) cmd += " " + quote(a);
+    cmd += " >" + quote((dir_ / "stdout").string()) + " 2>" + quote((dir_ / "stderr").string()) + " </dev/null";
+    const int status = std::system(cmd.c_str());
+    Run r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.out = slurp(dir_ / "stdout");
+    r.err = slurp(dir_ / "stderr");
+    return r;
+  }
+
+  fs::path write(const std::string& name, const std::string& bytes) {
+    std::ofstream(dir_ / name, std::ios::binary) << bytes;
+    return dir_ / name;
+  }
+
+  fs::path dir_;
+};
+
+const std::string kBracket = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/bracket.stl";
+
+TEST_F(Cli, EverySubcommandHasHelp) {
+  for (auto args : std::vector<std::vector<std::string>>{
+           {"--help"}, {"machine", "--help"}, {"machine", "check", "--help"}, {"voxelize", "--help"}, {"inspect", "--help"}}) {
+    const Run r = run(args);
+    EXPECT_EQ(r.exit_code, 0) << args[0];
+    EXPECT_NE(r.out.find("Usage"), std::string::npos) << r.out;
+  }
+}
+
+TEST_F(Cli, UsageErrorsExitWithTwo) {
+  EXPECT_EQ(run({}).exit_code, 2);
+  EXPECT_EQ(run({"frobnicate"}).exit_code, 2);
+  EXPECT_EQ(run({"voxelize", kBracket}).exit_code, 2);  // -o missing
+  const Run negative = run({"voxelize", kBracket, "--voxel", "-1", "-o", (dir_ / "x.vdb").string()});
+  EXPECT_EQ(negative.exit_code, 2);
+  EXPECT_NE(negative.err.find("--voxel"), std::string::npos) << negative.err;
+  EXPECT_FALSE(fs::exists(dir_ / "x.vdb"));
+}
+
+TEST_F(Cli, VoxelizesThePartAndWritesTheVdbAndSlices) {
+  const Run r = run({"voxelize", kBracket, "--voxel", "1", "-o", (dir_ / "b.vdb").string(), "--png-slices",
+                     (dir_ / "slices").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("volume"), std::string::npos) << r.out;
+  const auto solid = hybridctl::geometry::read_vdb(dir_ / "b.vdb");
+  EXPECT_DOUBLE_EQ(solid.voxel_size(), 1.0);
+  EXPECT_GT(solid.voxel_count(), 1000);
+  const auto layers = solid.bounding_box().hi.z - solid.bounding_box().lo.z;
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_ / "slices"), fs::directory_iterator{}), layers);
+  const Run inspect = run({"inspect", (dir_ / "b.vdb").string()});
+  EXPECT_EQ(inspect.exit_code, 0) << inspect.err;
+  EXPECT_NE(inspect.out.find(std::to_string(solid.voxel_count())), std::string::npos) << inspect.out;
+}
+
+TEST_F(Cli, InspectsAMesh) {
+  const Run r = run({"inspect", kBracket});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("closed       yes"), std::string::npos) << r.out;
+}
+
+struct BadStl {
+  const char* name;
+  std::string bytes;
+  const char* says;
+};
+
+std::string cube_binary(std::size_t keep_bytes = std::string::npos) {
+  std::string bytes(80, '\0');
+  const std::uint32_t n = 12;
+  bytes.append(reinterpret_cast<const char*>(&n), 4);
+  bytes.append(12 * 50, '\0');
+  return bytes.substr(0, keep_bytes);
+}
+
+TEST_F(Cli, EachBadStlKindGetsItsOwnMessageAndExitCodeThree) {
+  std::string nan_bytes = cube_binary();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  std::memcpy(nan_bytes.data() + 84 + 12, &nan, 4);
+  std::string garbage(3000, '\0');
+  for (std::size_t i = 0; i < garbage.size(); ++i) garbage[i] = char((i * 7919) % 251);
+  const std::vector<BadStl> cases = {
+      {"empty.stl", "", "empty file"},
+      {"short.stl", std::string(50, 'x'), "truncated: 50 bytes"},
+      {"truncated.stl", cube_binary(400), "truncated: the binary STL header announces 12 triangles"},
+      {"toolong.stl", cube_binary() + "extra", "size mismatch"},
+      {"nan.stl", nan_bytes, "non-finite coordinate"},
+      {"garbage.stl", garbage, "not an ASCII STL either"},
+      {"ascii.stl", "solid x\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 zero\n", "ascii.stl:5:14: expected a vertex coordinate"},
+      {"open.stl", "solid x\nfacet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 0\n  vertex 0 1 0\n endloop\nendfacet\nendsolid\n", "open mesh: 3 boundary edges"},
+  };
+  for (const BadStl& c : cases) {
+    const fs::path input = write(c.name, c.bytes);
+    const fs::path output = dir_ / (std::string(c.name) + ".vdb");
+    const Run r = run({"voxelize", input.string(), "-o", output.string()});
+    EXPECT_EQ(r.exit_code, 3) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(input.string()), std::string::npos) << c.name << " message does not name the file: " << r.err;
+    EXPECT_FALSE(fs::exists(output)) << c.name;
+  }
+}
+
+TEST_F(Cli, AnOutputDirectoryThatDoesNotExistIsBadInputAndNothingIsWritten) {
+  const Run r = run({"voxelize", kBracket, "--voxel", "2", "-o", (dir_ / "nope" / "b.vdb").string()});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_NE(r.err.find("does not exist"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, MachineCheckAcceptsTheExamplesAndPointsAtEveryProblem) {
+  for (const char* machine : {"hybrid-3axis.yaml", "multitask-b-axis.yaml"}) {
+    const Run ok = run({"machine", "check", std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/" + machine});
+    EXPECT_EQ(ok.exit_code, 0) << machine << ": " << ok.err;
+  }
+  const fs::path bad = write("bad.yaml", "name: broken\nenvelope:\n  x: [0, 100]\n  y: [0, 100]\n  z: [0, 100]\nfrobnicate: 3\n");
+  const Run r = run({"machine", "check", bad.string()});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_NE(r.err.find(bad.string() + ":6:1:"), std::string::npos) << r.err;
+}
+
+}  // namespace
