@@ -1,0 +1,516 @@
+#include "geometry/morphology.hpp"
+
+#include <fftw3.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+
+namespace hybridctl::geometry {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// Section ends are compared with this slack so that 30 mm at 0.1 mm voxels is level 300.
+constexpr double kLengthSlack = 1e-9;
+
+int& component(Index3& v, Axis a) { return a == Axis::X ? v.x : a == Axis::Y ? v.y : v.z; }
+
+std::int64_t clamp_extent(std::int64_t v) {
+  return std::clamp<std::int64_t>(v, -kUnboundedExtent, kUnboundedExtent);
+}
+
+// A dense box of values, x fastest.
+template <typename T>
+struct DenseGrid {
+  IndexBox box;
+  int nx = 0, ny = 0, nz = 0;
+  std::vector<T> values;
+
+  DenseGrid(IndexBox b, T fill) : box(b) {
+    if (!b.empty()) {
+      nx = b.hi.x - b.lo.x;
+      ny = b.hi.y - b.lo.y;
+      nz = b.hi.z - b.lo.z;
+    }
+    values.assign(std::size_t(nx) * std::size_t(ny) * std::size_t(nz), fill);
+  }
+  std::size_t index(int x, int y, int z) const {  // grid-relative coordinates
+    return (std::size_t(z) * std::size_t(ny) + std::size_t(y)) * std::size_t(nx) + std::size_t(x);
+  }
+  int size(Axis a) const { return a == Axis::X ? nx : a == Axis::Y ? ny : nz; }
+  std::size_t stride(Axis a) const {
+    return a == Axis::X ? 1 : a == Axis::Y ? std::size_t(nx) : std::size_t(nx) * std::size_t(ny);
+  }
+  // Calls fn(first_index) for every line along `a`, in parallel.
+  template <typename Fn>
+  void for_each_line(Axis a, Fn fn) const {
+    const Axis u = a == Axis::X ? Axis::Y : Axis::X;
+    const Axis v = a == Axis::Z ? Axis::Y : Axis::Z;
+    const int nu = size(u), nv = size(v);
+    const std::size_t su = stride(u), sv = stride(v);
+    tbb::parallel_for(tbb::blocked_range<int>(0, nv), [&](const tbb::blocked_range<int>& r) {
+      for (int j = r.begin(); j != r.end(); ++j)
+        for (int i = 0; i < nu; ++i) fn(std::size_t(i) * su + std::size_t(j) * sv);
+    });
+  }
+};
+
+// 0 on the solid's voxels, infinity elsewhere.
+DenseGrid<double> distance_seed(const Solid& solid, const IndexBox& box) {
+  DenseGrid<double> g(box, kInf);
+  const IndexBox inside = box_intersection(box, solid.bounding_box());
+  if (inside.empty()) return g;
+  tbb::parallel_for(tbb::blocked_range<int>(inside.lo.z, inside.hi.z), [&](const tbb::blocked_range<int>& r) {
+    for (int z = r.begin(); z != r.end(); ++z)
+      for (int y = inside.lo.y; y < inside.hi.y; ++y)
+        for (int x = inside.lo.x; x < inside.hi.x; ++x)
+          if (solid.contains({x, y, z})) g.values[g.index(x - box.lo.x, y - box.lo.y, z - box.lo.z)] = 0;
+  });
+  return g;
+}
+
+// One pass of the separable distance transform (Felzenszwalb & Huttenlocher): along
+// every line of `axis`, f(p) <- min_q f(q) + w (p - q)^2. Exact minimum of the computed
+// expressions: at each p the neighbouring parabolas of the envelope are checked too.
+void distance_pass(DenseGrid<double>& g, Axis axis, double w) {
+  const int n = g.size(axis);
+  const std::size_t stride = g.stride(axis);
+  g.for_each_line(axis, [&](std::size_t first) {
+    thread_local std::vector<double> f, z;
+    thread_local std::vector<int> v;
+    f.resize(std::size_t(n));
+    v.resize(std::size_t(n));
+    z.resize(std::size_t(n) + 1);
+    int k = -1;
+    for (int q = 0; q < n; ++q) {
+      f[std::size_t(q)] = g.values[first + std::size_t(q) * stride];
+      if (f[std::size_t(q)] == kInf) continue;
+      if (k < 0) {
+        k = 0;
+        v[0] = q;
+        z[0] = -kInf;
+        z[1] = kInf;
+        continue;
+      }
+      double s;
+      while (true) {
+        const int p = v[std::size_t(k)];
+        s = ((f[std::size_t(q)] + w * double(q) * double(q)) - (f[std::size_t(p)] + w * double(p) * double(p))) /
+            (2.0 * w * double(q - p));
+        if (s <= z[std::size_t(k)] && k > 0) {
+          --k;
+        } else {
+          break;
+        }
+      }
+      if (s <= z[std::size_t(k)]) {  // k == 0 and the new parabola is lower everywhere
+        v[0] = q;
+        z[1] = kInf;
+        continue;
+      }
+      ++k;
+      v[std::size_t(k)] = q;
+      z[std::size_t(k)] = s;
+      z[std::size_t(k) + 1] = kInf;
+    }
+    if (k < 0) return;  // nothing finite on this line
+    int j = 0;
+    for (int p = 0; p < n; ++p) {
+      while (z[std::size_t(j) + 1] < double(p)) ++j;
+      auto value = [&](int site) { return f[std::size_t(site)] + w * double((p - site) * (p - site)); };
+      double best = value(v[std::size_t(j)]);
+      if (j > 0) best = std::min(best, value(v[std::size_t(j) - 1]));
+      if (j < k) best = std::min(best, value(v[std::size_t(j) + 1]));
+      g.values[first + std::size_t(p) * stride] = best;
+    }
+  });
+}
+
+Solid threshold_into(const DenseGrid<double>& g, double limit, const Lattice& lattice, const IndexBox& domain) {
+  Solid out(lattice, domain);
+  const IndexBox b = box_intersection(domain, g.box);
+  if (b.empty()) return out;
+  tbb::parallel_for(tbb::blocked_range<int>(b.lo.z, b.hi.z), [&](const tbb::blocked_range<int>& r) {
+    for (int z = r.begin(); z != r.end(); ++z)
+      for (int y = b.lo.y; y < b.hi.y; ++y) {
+        auto row = out.row(y, z);
+        for (int x = b.lo.x; x < b.hi.x; ++x)
+          if (g.values[g.index(x - g.box.lo.x, y - g.box.lo.y, z - g.box.lo.z)] <= limit) {
+            const int word = (x >> 6) - out.first_word();
+            row[std::size_t(word)] |= std::uint64_t{1} << (x & 63);
+          }
+      }
+  });
+  return out;
+}
+
+// The radius squared (in voxels^2) of an axial body at each level t along its axis.
+struct AxialLevels {
+  std::vector<double> radius_sq;  // levels 0..n-1; negative: empty level
+  int tail_from = -1;             // an infinite tail from this level on, or -1
+  double tail_radius_sq = -1;
+};
+
+AxialLevels axial_levels(const AxialBody& body, double h) {
+  AxialLevels levels;
+  double finite_end = 0;
+  for (const AxialSection& s : body.sections) {
+    if (std::isinf(s.to)) {
+      if (s.kind != AxialSection::Kind::Cylinder) throw std::invalid_argument("only a cylinder section may be infinite");
+      const int from = int(std::ceil(s.from / h - kLengthSlack));
+      if (levels.tail_from < 0 || from < levels.tail_from) levels.tail_from = from;
+      levels.tail_radius_sq = std::max(levels.tail_radius_sq, (s.radius / h) * (s.radius / h));
+    } else {
+      finite_end = std::max(finite_end, s.to);
+    }
+  }
+  int count = int(std::floor(finite_end / h + kLengthSlack)) + 1;
+  if (levels.tail_from >= 0) count = std::max(count, levels.tail_from);
+  levels.radius_sq.assign(std::size_t(std::max(count, 0)), -1.0);
+  for (int t = 0; t < count; ++t) {
+    const double z = t * h;
+    double best = -1;
+    for (const AxialSection& s : body.sections) {
+      const double r2 = s.radius_squared_at(z);
+      if (r2 >= 0) best = std::max(best, r2 / (h * h));
+    }
+    if (levels.tail_from >= 0 && t >= levels.tail_from) best = std::max(best, levels.tail_radius_sq);
+    levels.radius_sq[std::size_t(t)] = best;
+  }
+  // Finite sections overlapping the tail widen it only where they are; levels past
+  // `count` are the tail alone.
+  return levels;
+}
+
+// Dilation along one axis by offsets {sign * t : t in [lo, hi]} (hi may be unbounded),
+// OR-ed into `out`: out[p] |= exists s with mask[s] and p - s = sign * t.
+void axial_dilate(const DenseGrid<std::uint8_t>& mask, DenseGrid<std::uint8_t>& out, Axis axis, int sign, int lo,
+                  std::int64_t hi) {
+  const int n = mask.size(axis);
+  const std::size_t stride = mask.stride(axis);
+  mask.for_each_line(axis, [&](std::size_t first) {
+    // Walk in the direction of the offsets so that sources come before their images.
+    std::int64_t last_source = std::numeric_limits<std::int64_t>::min() / 2;  // in walk steps
+    for (int step = 0; step < n; ++step) {
+      // The source that can reach this step at the smallest offset `lo` is step - lo.
+      const int src = step - lo;
+      if (src >= 0 && src < n) {
+        const int src_index = sign > 0 ? src : n - 1 - src;
+        if (mask.values[first + std::size_t(src_index) * stride]) last_source = src;
+      }
+      if (step - last_source <= hi) {
+        const int p = sign > 0 ? step : n - 1 - step;
+        out.values[first + std::size_t(p) * stride] = 1;
+      }
+    }
+  });
+}
+
+Solid dilate_axial(const Solid& solid, const AxialBody& body, const IndexBox& work, const IndexBox& domain) {
+  const double h = solid.voxel_size();
+  const Axis a = body.direction.axis;
+  DenseGrid<double> perp = distance_seed(solid, work);
+  for (Axis other : {Axis::X, Axis::Y, Axis::Z})
+    if (other != a) distance_pass(perp, other, 1.0);
+  const AxialLevels levels = axial_levels(body, h);
+
+  // Group levels of equal radius into runs [lo, hi] so each radius is thresholded once.
+  std::map<double, std::vector<std::pair<int, std::int64_t>>> runs;
+  const int n = int(levels.radius_sq.size());
+  for (int t = 0; t < n;) {
+    const double r2 = levels.radius_sq[std::size_t(t)];
+    int end = t;
+    while (end + 1 < n && levels.radius_sq[std::size_t(end) + 1] == r2) ++end;
+    std::int64_t hi = end;
+    if (end == n - 1 && levels.tail_from >= 0 && r2 == levels.tail_radius_sq) hi = kUnboundedExtent;
+    if (r2 >= 0) runs[r2].push_back({t, hi});
+    t = end + 1;
+  }
+  if (levels.tail_from >= 0 && (n == 0 || levels.radius_sq.back() != levels.tail_radius_sq) &&
+      levels.tail_radius_sq >= 0) {
+    runs[levels.tail_radius_sq].push_back({std::max(n, levels.tail_from), kUnboundedExtent});
+  }
+
+  DenseGrid<std::uint8_t> result(work, 0), mask(work, 0);
+  for (const auto& [r2, intervals] : runs) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mask.values.size(), 1 << 16),
+                      [&, r2 = r2](const tbb::blocked_range<std::size_t>& r) {
+                        for (std::size_t i = r.begin(); i != r.end(); ++i) mask.values[i] = perp.values[i] <= r2;
+                      });
+    for (const auto& [lo, hi] : intervals) axial_dilate(mask, result, a, body.direction.sign, lo, hi);
+  }
+  Solid out(solid.lattice(), domain);
+  const IndexBox b = box_intersection(domain, work);
+  for (int z = b.lo.z; z < b.hi.z; ++z)
+    for (int y = b.lo.y; y < b.hi.y; ++y)
+      for (int x = b.lo.x; x < b.hi.x; ++x)
+        if (result.values[result.index(x - work.lo.x, y - work.lo.y, z - work.lo.z)]) out.set({x, y, z});
+  return out;
+}
+
+Solid dilate_brute_force(const Solid& solid, const std::vector<Index3>& offsets, const IndexBox& domain) {
+  Solid out(solid.lattice(), domain);
+  solid.for_each_voxel([&](Index3 s) {
+    for (const Index3& d : offsets) {
+      const Index3 p{s.x + d.x, s.y + d.y, s.z + d.z};
+      if (domain.contains(p)) out.set(p);
+    }
+  });
+  return out;
+}
+
+std::mutex fftw_planner_mutex;  // FFTW's planner is not thread-safe
+
+Solid dilate_fft(const Solid& solid, const std::vector<Index3>& offsets, const IndexBox& source, const IndexBox& domain) {
+  Solid out(solid.lattice(), domain);
+  if (source.empty() || offsets.empty()) return out;
+  IndexBox ext{{INT32_MAX, INT32_MAX, INT32_MAX}, {INT32_MIN, INT32_MIN, INT32_MIN}};
+  for (const Index3& d : offsets) {
+    ext.lo = {std::min(ext.lo.x, d.x), std::min(ext.lo.y, d.y), std::min(ext.lo.z, d.z)};
+    ext.hi = {std::max(ext.hi.x, d.x + 1), std::max(ext.hi.y, d.y + 1), std::max(ext.hi.z, d.z + 1)};
+  }
+  // Linear (not cyclic) convolution: pad each axis to source + element - 1.
+  const int nx = (source.hi.x - source.lo.x) + (ext.hi.x - ext.lo.x) - 1;
+  const int ny = (source.hi.y - source.lo.y) + (ext.hi.y - ext.lo.y) - 1;
+  const int nz = (source.hi.z - source.lo.z) + (ext.hi.z - ext.lo.z) - 1;
+  const std::size_t real_size = std::size_t(nx) * std::size_t(ny) * std::size_t(nz);
+  const std::size_t complex_size = std::size_t(nz) * std::size_t(ny) * std::size_t(nx / 2 + 1);
+  std::vector<double> a(real_size, 0.0), b(real_size, 0.0);
+  auto at = [&](int x, int y, int z) { return (std::size_t(z) * std::size_t(ny) + std::size_t(y)) * std::size_t(nx) + std::size_t(x); };
+  solid.for_each_voxel([&](Index3 s) {
+    if (source.contains(s)) a[at(s.x - source.lo.x, s.y - source.lo.y, s.z - source.lo.z)] = 1.0;
+  });
+  for (const Index3& d : offsets) b[at(d.x - ext.lo.x, d.y - ext.lo.y, d.z - ext.lo.z)] = 1.0;
+  fftw_complex* fa = fftw_alloc_complex(complex_size);
+  fftw_complex* fb = fftw_alloc_complex(complex_size);
+  fftw_plan forward_a, forward_b, backward;
+  {
+    std::lock_guard lock(fftw_planner_mutex);
+    forward_a = fftw_plan_dft_r2c_3d(nz, ny, nx, a.data(), fa, FFTW_ESTIMATE);
+    forward_b = fftw_plan_dft_r2c_3d(nz, ny, nx, b.data(), fb, FFTW_ESTIMATE);
+    backward = fftw_plan_dft_c2r_3d(nz, ny, nx, fa, a.data(), FFTW_ESTIMATE);
+  }
+  fftw_execute(forward_a);
+  fftw_execute(forward_b);
+  for (std::size_t i = 0; i < complex_size; ++i) {
+    const double re = fa[i][0] * fb[i][0] - fa[i][1] * fb[i][1];
+    const double im = fa[i][0] * fb[i][1] + fa[i][1] * fb[i][0];
+    fa[i][0] = re;
+    fa[i][1] = im;
+  }
+  fftw_execute(backward);
+  {
+    std::lock_guard lock(fftw_planner_mutex);
+    fftw_destroy_plan(forward_a);
+    fftw_destroy_plan(forward_b);
+    fftw_destroy_plan(backward);
+  }
+  fftw_free(fa);
+  fftw_free(fb);
+  // A count of overlapping voxels, scaled by the transform size; half a voxel decides.
+  const double scale = double(real_size);
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x) {
+        if (a[at(x, y, z)] / scale <= 0.5) continue;
+        const Index3 p{source.lo.x + ext.lo.x + x, source.lo.y + ext.lo.y + y, source.lo.z + ext.lo.z + z};
+        if (domain.contains(p)) out.set(p);
+      }
+  return out;
+}
+
+bool is_finite_extent(const IndexBox& e) {
+  return e.lo.x > -kUnboundedExtent && e.lo.y > -kUnboundedExtent && e.lo.z > -kUnboundedExtent &&
+         e.hi.x < kUnboundedExtent && e.hi.y < kUnboundedExtent && e.hi.z < kUnboundedExtent;
+}
+
+IndexBox grow(const IndexBox& b, const IndexBox& ext) {
+  return {{int(clamp_extent(std::int64_t(b.lo.x) + ext.lo.x)), int(clamp_extent(std::int64_t(b.lo.y) + ext.lo.y)),
+           int(clamp_extent(std::int64_t(b.lo.z) + ext.lo.z))},
+          {int(clamp_extent(std::int64_t(b.hi.x) + ext.hi.x - 1)), int(clamp_extent(std::int64_t(b.hi.y) + ext.hi.y - 1)),
+           int(clamp_extent(std::int64_t(b.hi.z) + ext.hi.z - 1))}};
+}
+
+}  // namespace
+
+double AxialSection::radius_squared_at(double z) const {
+  if (z < from - kLengthSlack * std::max(1.0, std::abs(from)) || z > to + kLengthSlack * std::max(1.0, std::abs(to)))
+    return -1;
+  switch (kind) {
+    case Kind::Cylinder: return radius * radius;
+    case Kind::Sphere: return radius * radius - (z - centre) * (z - centre);
+    case Kind::Torus: {
+      const double tube_sq = radius * radius - (z - centre) * (z - centre);
+      if (tube_sq < 0) return -1;
+      const double r = ring + std::sqrt(tube_sq);
+      return r * r;
+    }
+  }
+  return -1;
+}
+
+AxialBody cylinder_body(AxisDirection direction, double radius, double length) {
+  return {direction, {{AxialSection::Kind::Cylinder, 0, length, radius, 0, 0}}};
+}
+
+AxialBody ray_body(AxisDirection direction) {
+  return {direction, {{AxialSection::Kind::Cylinder, 0, kInf, 0, 0, 0}}};
+}
+
+StructuringElement reflected(const StructuringElement& element) {
+  if (const auto* body = std::get_if<AxialBody>(&element)) {
+    AxialBody r = *body;
+    r.direction = r.direction.reversed();
+    return r;
+  }
+  if (const auto* set = std::get_if<VoxelOffsets>(&element)) {
+    VoxelOffsets r = *set;
+    for (Index3& d : r.offsets) d = {-d.x, -d.y, -d.z};
+    return r;
+  }
+  return element;  // balls and ellipsoids are symmetric
+}
+
+std::vector<Index3> offsets_of(const StructuringElement& element, double h, int max_length_voxels) {
+  std::vector<Index3> out;
+  if (const auto* ball = std::get_if<Ball>(&element)) {
+    const double r = ball->radius / h, r2 = r * r;
+    const int n = int(std::floor(r));
+    for (int z = -n; z <= n; ++z)
+      for (int y = -n; y <= n; ++y)
+        for (int x = -n; x <= n; ++x)
+          if (double(x * x) + double(y * y) + double(z * z) <= r2) out.push_back({x, y, z});
+  } else if (const auto* e = std::get_if<Ellipsoid>(&element)) {
+    const double wx = (h / e->radii.x) * (h / e->radii.x), wy = (h / e->radii.y) * (h / e->radii.y),
+                 wz = (h / e->radii.z) * (h / e->radii.z);
+    const int nx = int(std::floor(e->radii.x / h)), ny = int(std::floor(e->radii.y / h)), nz = int(std::floor(e->radii.z / h));
+    for (int z = -nz; z <= nz; ++z)
+      for (int y = -ny; y <= ny; ++y)
+        for (int x = -nx; x <= nx; ++x)
+          if (wx * double(x * x) + wy * double(y * y) + wz * double(z * z) <= 1.0) out.push_back({x, y, z});
+  } else if (const auto* body = std::get_if<AxialBody>(&element)) {
+    const AxialLevels levels = axial_levels(*body, h);
+    const Axis a = body->direction.axis;
+    const int last = levels.tail_from >= 0 ? std::max(int(levels.radius_sq.size()), max_length_voxels)
+                                           : int(levels.radius_sq.size());
+    for (int t = 0; t < last; ++t) {
+      const double r2 = t < int(levels.radius_sq.size()) ? levels.radius_sq[std::size_t(t)] : levels.tail_radius_sq;
+      if (r2 < 0) continue;
+      const int n = int(std::floor(std::sqrt(r2)));
+      for (int v = -n; v <= n; ++v)
+        for (int u = -n; u <= n; ++u) {
+          if (double(u * u) + double(v * v) > r2) continue;
+          Index3 d;
+          component(d, a) = body->direction.sign * t;
+          component(d, a == Axis::X ? Axis::Y : Axis::X) = u;
+          component(d, a == Axis::Z ? Axis::Y : Axis::Z) = v;
+          out.push_back(d);
+        }
+    }
+  } else {
+    out = std::get<VoxelOffsets>(element).offsets;
+  }
+  return out;
+}
+
+IndexBox element_extent(const StructuringElement& element, double h) {
+  if (const auto* body = std::get_if<AxialBody>(&element)) {
+    const AxialLevels levels = axial_levels(*body, h);
+    double r2 = levels.tail_radius_sq;
+    for (double v : levels.radius_sq) r2 = std::max(r2, v);
+    const int n = r2 >= 0 ? int(std::floor(std::sqrt(r2))) : 0;
+    IndexBox box{{-n, -n, -n}, {n + 1, n + 1, n + 1}};
+    const Axis a = body->direction.axis;
+    const int length = levels.tail_from >= 0 ? kUnboundedExtent : std::max(int(levels.radius_sq.size()), 1);
+    if (body->direction.sign > 0) {
+      component(box.lo, a) = 0;
+      component(box.hi, a) = length;
+    } else {
+      component(box.lo, a) = levels.tail_from >= 0 ? -kUnboundedExtent : -length + 1;
+      component(box.hi, a) = 1;
+    }
+    return box;
+  }
+  const std::vector<Index3> offsets = offsets_of(element, h);
+  if (offsets.empty()) return {};
+  IndexBox box{{INT32_MAX, INT32_MAX, INT32_MAX}, {INT32_MIN, INT32_MIN, INT32_MIN}};
+  for (const Index3& d : offsets) {
+    box.lo = {std::min(box.lo.x, d.x), std::min(box.lo.y, d.y), std::min(box.lo.z, d.z)};
+    box.hi = {std::max(box.hi.x, d.x + 1), std::max(box.hi.y, d.y + 1), std::max(box.hi.z, d.z + 1)};
+  }
+  return box;
+}
+
+Solid dilate(const Solid& solid, const StructuringElement& element, const IndexBox& requested_domain,
+             MorphologyMethod method) {
+  const double h = solid.voxel_size();
+  const IndexBox ext = element_extent(element, h);
+  const IndexBox bbox = solid.bounding_box();
+  if (requested_domain.empty() && !is_finite_extent(ext)) {
+    throw std::invalid_argument("dilation by an infinite element needs a domain to clip to");
+  }
+  const IndexBox domain = requested_domain.empty() ? grow(bbox, ext) : requested_domain;
+  if (bbox.empty() || ext.empty() || domain.empty()) return Solid(solid.lattice(), domain);
+  // Sources that can reach the domain: domain minus the element's extent.
+  const IndexBox reflected_ext{{-(ext.hi.x - 1), -(ext.hi.y - 1), -(ext.hi.z - 1)}, {-ext.lo.x + 1, -ext.lo.y + 1, -ext.lo.z + 1}};
+  const IndexBox source = box_intersection(bbox, grow(domain, reflected_ext));
+  if (source.empty()) return Solid(solid.lattice(), domain);
+
+  if (method == MorphologyMethod::BruteForce || method == MorphologyMethod::Fft) {
+    // Infinite bodies are cut where they leave the domain.
+    const int reach = std::max({domain.hi.x - source.lo.x, source.hi.x - domain.lo.x, domain.hi.y - source.lo.y,
+                                source.hi.y - domain.lo.y, domain.hi.z - source.lo.z, source.hi.z - domain.lo.z});
+    const std::vector<Index3> offsets = offsets_of(element, h, reach + 1);
+    if (method == MorphologyMethod::BruteForce) return dilate_brute_force(solid, offsets, domain);
+    return dilate_fft(solid, offsets, source, domain);
+  }
+  // The working box holds the sources and the domain.
+  const IndexBox work = box_union(source, domain);
+  if (const auto* ball = std::get_if<Ball>(&element)) {
+    DenseGrid<double> g = distance_seed(solid, work);
+    for (Axis a : {Axis::X, Axis::Y, Axis::Z}) distance_pass(g, a, 1.0);
+    const double r = ball->radius / h;
+    return threshold_into(g, r * r, solid.lattice(), domain);
+  }
+  if (const auto* e = std::get_if<Ellipsoid>(&element)) {
+    DenseGrid<double> g = distance_seed(solid, work);
+    distance_pass(g, Axis::X, (h / e->radii.x) * (h / e->radii.x));
+    distance_pass(g, Axis::Y, (h / e->radii.y) * (h / e->radii.y));
+    distance_pass(g, Axis::Z, (h / e->radii.z) * (h / e->radii.z));
+    return threshold_into(g, 1.0, solid.lattice(), domain);
+  }
+  if (const auto* body = std::get_if<AxialBody>(&element)) return dilate_axial(solid, *body, work, domain);
+  return dilate_fft(solid, offsets_of(element, h), source, domain);
+}
+
+Solid erode(const Solid& solid, const StructuringElement& element, MorphologyMethod method) {
+  const IndexBox bbox = solid.bounding_box();
+  if (bbox.empty()) return Solid(solid.lattice(), {});
+  // Outside the solid's box everything is air; one layer of it beyond the element's
+  // reach (or beyond the box, for infinite elements) is enough for the complement.
+  const IndexBox ext = element_extent(element, solid.voxel_size());
+  const Index3 size{bbox.hi.x - bbox.lo.x, bbox.hi.y - bbox.lo.y, bbox.hi.z - bbox.lo.z};
+  auto low = [](int e, int n) { return e <= -kUnboundedExtent ? -n - 1 : e; };
+  auto high = [](int e, int n) { return e >= kUnboundedExtent ? n + 2 : e; };
+  const IndexBox margin{{low(ext.lo.x, size.x), low(ext.lo.y, size.y), low(ext.lo.z, size.z)},
+                        {high(ext.hi.x, size.x), high(ext.hi.y, size.y), high(ext.hi.z, size.z)}};
+  const IndexBox world = grow(bbox, margin);
+  const Solid air = complement(solid, world);
+  // p survives when p + B misses the air: p is not in air (+) (-B).
+  const Solid reached = dilate(air, reflected(element), bbox, method);
+  return subtract(Solid::filled(solid.lattice(), bbox), reached);
+}
+
+Solid open(const Solid& solid, const StructuringElement& element, MorphologyMethod method) {
+  return dilate(erode(solid, element, method), element, {}, method);
+}
+
+Solid close(const Solid& solid, const StructuringElement& element, MorphologyMethod method) {
+  return erode(dilate(solid, element, {}, method), element, method);
+}
+
+}  // namespace hybridctl::geometry
