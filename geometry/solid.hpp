@@ -102,6 +102,11 @@ class Solid {
   int words_per_row() const { return wx1_ - wx0_; }
   std::span<const std::uint64_t> row(int y, int z) const;
   std::span<std::uint64_t> row(int y, int z);
+  // The 64 voxels x = word * 64 ... word * 64 + 63 of row (y, z); 0 outside storage.
+  std::uint64_t word_at(int word, int y, int z) const {
+    if (words_.empty() || y < y0_ || y >= y1_ || z < z0_ || z >= z1_ || word < wx0_ || word >= wx1_) return 0;
+    return words_[row_offset(y, z) + std::size_t(word - wx0_)];
+  }
 
   // Same lattice and same occupied voxels (storage boxes may differ).
   friend bool operator==(const Solid& a, const Solid& b);

@@ -1,0 +1,93 @@
+#pragma once
+// Atoms (the paper's canonical intersection terms, section 6): every voxel of the
+// planning domain gets an n-bit code saying which primitives contain it, and voxels
+// with equal codes form one atom. Atoms are the smallest units any plan can deposit or
+// remove, so a design is makeable only as a union of whole atoms.
+//
+// The decomposition is built incrementally: adding a primitive splits each atom it
+// partly covers into the part inside and the part outside (section 8), and gives the
+// same partition as a recompute from scratch.
+
+#include <cstdint>
+#include <vector>
+
+#include "geometry/solid.hpp"
+#include "planner/atom_code.hpp"
+
+namespace hybridctl::planner {
+
+using geometry::Index3;
+using geometry::IndexBox;
+using geometry::Lattice;
+using geometry::Solid;
+using geometry::Vec3;
+
+class AtomDecomposition {
+ public:
+  // One atom (code 0...0) covering `domain`, before any primitive.
+  AtomDecomposition(const Lattice& lattice, const IndexBox& domain);
+  // Decomposes the domain by all `primitives` at once (the reference computation).
+  static AtomDecomposition recompute(const Lattice& lattice, const IndexBox& domain,
+                                     const std::vector<const Solid*>& primitives);
+
+  // Splits every atom by one more primitive; parts of it outside the domain are ignored.
+  void add_primitive(const Solid& primitive);
+
+  int primitive_count() const { return primitives_; }
+  int atom_count() const { return int(codes_.size()); }
+  const AtomCode& code(int atom) const { return codes_[std::size_t(atom)]; }
+  const Lattice& lattice() const { return lattice_; }
+  const IndexBox& domain() const { return domain_; }
+  // The atom of a voxel of the domain.
+  int atom_at(Index3 v) const;
+  // The voxels of one atom, or of a set of atoms (selected[atom] true), as a solid.
+  Solid atom_solid(int atom) const;
+  Solid union_of(const std::vector<bool>& selected) const;
+
+  // Same partition, same codes (atom numbering may differ).
+  friend bool same_partition(const AtomDecomposition& a, const AtomDecomposition& b);
+
+ private:
+  template <typename Fn>
+  void for_each_voxel_label(Fn fn) const;
+
+  Lattice lattice_;
+  IndexBox domain_;
+  int primitives_ = 0;
+  std::vector<AtomCode> codes_;
+  std::vector<std::int32_t> labels_;  // atom per domain voxel, x fastest
+};
+
+// What an atom is to the design, given the tolerance zone (section 6, relaxed): a
+// must-in atom reaches the design shrunk by the tolerance, a must-out atom reaches the
+// outside of the design grown by the tolerance, a violating atom does both, and a free
+// atom lies wholly in the tolerance band. Slivers (below the volume threshold) are
+// discretization noise and count as free.
+enum class AtomClass { MustIn, MustOut, Free, Violating };
+const char* to_string(AtomClass c);
+
+struct AtomMeasures {
+  AtomCode code;
+  std::int64_t voxels = 0;
+  std::int64_t voxels_in_design = 0;
+  std::int64_t voxels_in_core = 0;     // inside the design shrunk by the tolerance
+  std::int64_t voxels_beyond_hull = 0; // outside the design grown by the tolerance
+  double volume = 0;                   // mm^3
+  double volume_in_design = 0;         // mm^3
+  IndexBox bounding_box;
+  Vec3 centroid;                       // mm
+  AtomClass atom_class = AtomClass::Free;
+  bool sliver = false;
+};
+
+// The design shrunk and grown by the tolerance (balls of the tolerance radius).
+struct ToleranceZone {
+  Solid core;  // design (-) ball
+  Solid hull;  // design (+) ball
+};
+ToleranceZone make_tolerance_zone(const Solid& design, double tolerance_mm);
+
+std::vector<AtomMeasures> measure_atoms(const AtomDecomposition& atoms, const Solid& design, const ToleranceZone& zone,
+                                        double sliver_threshold_mm3);
+
+}  // namespace hybridctl::planner

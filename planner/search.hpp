@@ -1,0 +1,108 @@
+#pragma once
+// Plan search (paper section 7) on the symbolic problem: atoms with volumes and
+// classes, primitives as sets of atoms. A state is the set of atoms present; an
+// additive action unites its primitive's atoms with it, a subtractive one removes
+// them. Plans obey C1-C4: a chain of actions (C1), AM as union and SM as intersection
+// with the complement (C2), the first action additive (C3), raw stock only first (C4).
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace hybridctl::planner {
+
+enum class Mode { Additive, Subtractive };
+
+// A set of atoms, one bit each.
+class AtomSet {
+ public:
+  AtomSet() = default;
+  explicit AtomSet(int atoms) : words_(std::size_t((atoms + 63) / 64), 0) {}
+  bool test(int i) const { return (words_[std::size_t(i / 64)] >> (i % 64)) & 1u; }
+  void set(int i, bool v = true) {
+    auto& w = words_[std::size_t(i / 64)];
+    const std::uint64_t bit = std::uint64_t{1} << (i % 64);
+    w = v ? (w | bit) : (w & ~bit);
+  }
+  const std::vector<std::uint64_t>& words() const { return words_; }
+  std::vector<std::uint64_t>& words() { return words_; }
+  friend bool operator==(const AtomSet&, const AtomSet&) = default;
+
+ private:
+  std::vector<std::uint64_t> words_;
+};
+
+struct AtomSpec {
+  double volume = 0;  // mm^3
+  bool must_in = false;
+  bool must_out = false;  // both false: free either way
+};
+
+struct PrimitiveSpec {
+  std::string name;
+  Mode mode = Mode::Additive;
+  bool raw_stock = false;
+  double cost_per_mm3 = 1.0;
+  AtomSet atoms;          // the atoms inside the primitive
+  std::string tool;       // tool or head identity, for tool-change costs
+  std::string setup;      // setup name, for setup-change costs
+};
+
+struct FixedCosts {
+  double tool_change = 0;
+  double setup_change = 0;
+  double mode_switch = 0;
+};
+
+struct PlanningProblem {
+  std::vector<AtomSpec> atoms;
+  std::vector<PrimitiveSpec> primitives;
+  FixedCosts fixed;
+  // Costs are divided by this volume (the design's bounding box, mm^3) so that plans of
+  // different parts compare; 1 leaves them in cost units.
+  double normaliser = 1.0;
+  int max_uses = 1;  // how often one primitive may appear in a plan
+};
+
+struct PlanStep {
+  int primitive = -1;
+  double volume = 0;  // mm^3 really deposited or removed in this state
+  double cost = 0;    // normalised, including fixed costs incurred by this step
+};
+
+struct Plan {
+  std::vector<PlanStep> steps;
+  double cost = 0;  // normalised total
+  AtomSet final_state;
+};
+
+struct SearchStats {
+  std::int64_t expanded = 0;
+  std::int64_t generated = 0;
+  bool exhausted = false;  // the search space ran out before k plans were found
+  bool limit_reached = false;
+};
+
+struct SearchOptions {
+  int top_k = 5;
+  std::int64_t max_expansions = 5'000'000;
+};
+
+// The k cheapest distinct plans, cheapest first, by A* with an admissible and
+// consistent heuristic (every missing must-in atom must still be deposited by an
+// additive primitive containing it, every present must-out atom removed by a
+// subtractive one, each at that primitive's cost per mm^3 at least).
+std::vector<Plan> find_plans(const PlanningProblem& problem, const SearchOptions& options = {},
+                             SearchStats* stats = nullptr);
+
+// Every plan, by depth-first enumeration, cheapest first, at most `limit` kept. The
+// oracle for find_plans on small problems.
+std::vector<Plan> enumerate_plans(const PlanningProblem& problem, std::size_t limit = SIZE_MAX);
+
+// True when every must-in atom is in `state` and no must-out atom is.
+bool is_goal(const PlanningProblem& problem, const AtomSet& state);
+
+// The plan as the paper writes it, e.g. "(((P1 ∪ P2) − P3) − P4)".
+std::string expression(const PlanningProblem& problem, const Plan& plan);
+
+}  // namespace hybridctl::planner

@@ -1,0 +1,73 @@
+#pragma once
+// Building planning problems from voxel primitives, as the planner does, so the tests
+// exercise the symbolic search on real atom decompositions.
+
+#include <string>
+#include <vector>
+
+#include "geometry/shapes.hpp"
+#include "planner/atoms.hpp"
+#include "planner/search.hpp"
+
+namespace hybridctl::planner::testing {
+
+struct VoxelPrimitive {
+  std::string name;
+  Mode mode;
+  bool raw = false;
+  double cost = 1.0;
+  Solid region;
+};
+
+struct VoxelProblem {
+  std::vector<VoxelPrimitive> primitives;
+  Solid design;
+  IndexBox domain;
+  AtomDecomposition atoms;
+  PlanningProblem problem;
+};
+
+// Atoms of the primitives over `domain`, classified exactly against the design.
+inline VoxelProblem make_problem(std::vector<VoxelPrimitive> prims, const Solid& design, const IndexBox& domain) {
+  AtomDecomposition atoms(design.lattice(), domain);
+  for (const auto& p : prims) atoms.add_primitive(p.region);
+  const auto measures = measure_atoms(atoms, design, make_tolerance_zone(design, 0), 0);
+  PlanningProblem problem;
+  for (const auto& m : measures) {
+    AtomSpec a;
+    a.volume = m.volume;
+    a.must_in = m.atom_class == AtomClass::MustIn || m.atom_class == AtomClass::Violating;
+    a.must_out = m.atom_class == AtomClass::MustOut || m.atom_class == AtomClass::Violating;
+    problem.atoms.push_back(a);
+  }
+  for (int i = 0; i < int(prims.size()); ++i) {
+    PrimitiveSpec s;
+    s.name = prims[std::size_t(i)].name;
+    s.mode = prims[std::size_t(i)].mode;
+    s.raw_stock = prims[std::size_t(i)].raw;
+    s.cost_per_mm3 = prims[std::size_t(i)].cost;
+    s.atoms = AtomSet(atoms.atom_count());
+    for (int a = 0; a < atoms.atom_count(); ++a)
+      if (atoms.code(a).test(i)) s.atoms.set(a);
+    problem.primitives.push_back(s);
+  }
+  return {std::move(prims), design, domain, std::move(atoms), std::move(problem)};
+}
+
+// The plan carried out on the voxels themselves.
+inline Solid evaluate(const VoxelProblem& vp, const Plan& plan) {
+  Solid state(vp.design.lattice(), vp.domain);
+  for (const PlanStep& step : plan.steps) {
+    const VoxelPrimitive& p = vp.primitives[std::size_t(step.primitive)];
+    state = p.mode == Mode::Additive ? unite(state, p.region) : subtract(state, p.region);
+  }
+  return intersect(state, Solid::filled(vp.design.lattice(), vp.domain));
+}
+
+inline Solid atoms_union(const VoxelProblem& vp, const AtomSet& set) {
+  std::vector<bool> selected(static_cast<std::size_t>(vp.atoms.atom_count()));
+  for (int a = 0; a < vp.atoms.atom_count(); ++a) selected[std::size_t(a)] = set.test(a);
+  return vp.atoms.union_of(selected);
+}
+
+}  // namespace hybridctl::planner::testing

@@ -1,0 +1,195 @@
+// Plan search: the paper's worked example, A* against the exhaustive oracle on random
+// instances, and every plan checked on the voxels it claims to make.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <set>
+
+#include "planner_fixtures.hpp"
+
+namespace hybridctl::planner {
+namespace {
+
+using geometry::Box3;
+using geometry::make_box;
+using testing::make_problem;
+using testing::VoxelPrimitive;
+using testing::VoxelProblem;
+
+const Lattice kUnit{1.0, {0, 0, 0}};
+
+Solid rect(double x0, double y0, double x1, double y1) { return make_box(kUnit, {{x0, y0, 0}, {x1, y1, 1}}); }
+
+// The four rectangles of the paper's Fig. 9: P2 and P4 disjoint, 11 of the 16
+// canonical intersections non-empty (A_0011, A_0101, A_0111, A_1101, A_1111 empty).
+VoxelProblem paper_example(bool p1_is_raw_stock) {
+  std::vector<VoxelPrimitive> prims = {
+      {"P1", Mode::Additive, p1_is_raw_stock, 1.0, rect(0, 0, 10, 6)},
+      {"P2", Mode::Additive, false, 1.0, rect(7, 2, 14, 8)},
+      {"P3", Mode::Subtractive, false, 1.0, rect(4, 4, 12, 10)},
+      {"P4", Mode::Subtractive, false, 1.0, rect(2, -2, 6, 5)},
+  };
+  const IndexBox domain{{-1, -3, 0}, {15, 11, 1}};
+  // Target A_0100 U A_1000 U A_1100: (P1 U P2) minus P3 and P4.
+  const Solid design = subtract(subtract(unite(prims[0].region, prims[1].region), prims[2].region), prims[3].region);
+  return make_problem(std::move(prims), design, domain);
+}
+
+std::set<std::string> expressions(const VoxelProblem& vp, const std::vector<Plan>& plans) {
+  std::set<std::string> out;
+  for (const Plan& p : plans) out.insert(expression(vp.problem, p));
+  return out;
+}
+
+TEST(PaperExample, HasElevenNonEmptyAtoms) {
+  const VoxelProblem vp = paper_example(false);
+  EXPECT_EQ(vp.atoms.atom_count(), 11);
+  std::set<std::string> codes;
+  for (int a = 0; a < vp.atoms.atom_count(); ++a) codes.insert(vp.atoms.code(a).bits(4));
+  for (const char* empty : {"0011", "0101", "0111", "1101", "1111"}) EXPECT_EQ(codes.count(empty), 0u) << empty;
+}
+
+TEST(PaperExample, FindsE1E2TheirP1P2SwapsAndE3ButNeverE4) {
+  const VoxelProblem vp = paper_example(false);
+  const auto plans = find_plans(vp.problem, {5});
+  ASSERT_EQ(plans.size(), 5u);
+  const std::set<std::string> expected = {
+      "(((P1 \u222A P2) \u2212 P3) \u2212 P4)",  // E1
+      "(((P1 \u222A P2) \u2212 P4) \u2212 P3)",  // E2
+      "(((P2 \u222A P1) \u2212 P3) \u2212 P4)",
+      "(((P2 \u222A P1) \u2212 P4) \u2212 P3)",
+      "(((P1 \u2212 P4) \u222A P2) \u2212 P3)",  // E3
+  };
+  EXPECT_EQ(expressions(vp, plans), expected);
+  // E4 = (((P1 - P4) - P3) U P2) leaves P2's part inside P3: not the design.
+  Plan e4;
+  e4.steps = {{0, 0, 0}, {3, 0, 0}, {2, 0, 0}, {1, 0, 0}};
+  EXPECT_FALSE(testing::evaluate(vp, e4) == vp.design);
+  for (const Plan& p : plans) EXPECT_EQ(testing::evaluate(vp, p), vp.design) << expression(vp.problem, p);
+  // Costs are ordered and order matters: E1 and E2 remove different volumes.
+  for (std::size_t i = 1; i < plans.size(); ++i) EXPECT_LE(plans[i - 1].cost, plans[i].cost);
+}
+
+TEST(PaperExample, WithP1AsRawStockOnlyPlansStartingFromItRemain) {
+  const VoxelProblem vp = paper_example(true);
+  const auto plans = find_plans(vp.problem, {5});
+  const std::set<std::string> expected = {
+      "(((P1 \u222A P2) \u2212 P3) \u2212 P4)",
+      "(((P1 \u222A P2) \u2212 P4) \u2212 P3)",
+      "(((P1 \u2212 P4) \u222A P2) \u2212 P3)",
+  };
+  EXPECT_EQ(expressions(vp, plans), expected);
+}
+
+// A random instance whose design is the outcome of a random valid plan, so that
+// solutions exist; primitives are boxes in a small grid.
+VoxelProblem random_instance(std::mt19937& rng, int n) {
+  std::uniform_real_distribution<double> at(0, 10), size(2, 8), cost(0.2, 3.0);
+  std::vector<VoxelPrimitive> prims;
+  for (int i = 0; i < n; ++i) {
+    const Mode mode = i == 0 || rng() % 2 ? Mode::Additive : Mode::Subtractive;
+    const double x = at(rng), y = at(rng), z = at(rng) / 3;
+    prims.push_back({"P" + std::to_string(i + 1), mode, i == 0 && rng() % 2, cost(rng),
+                     make_box(kUnit, {{x, y, z}, {x + size(rng), y + size(rng), z + size(rng) / 2}})});
+  }
+  const IndexBox domain{{0, 0, 0}, {18, 18, 8}};
+  std::vector<int> order(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) order[std::size_t(i)] = i;
+  std::shuffle(order.begin() + 1, order.end(), rng);  // P1 (additive) first
+  const int length = 1 + int(rng() % unsigned(n));
+  Solid design(kUnit, domain);
+  for (int s = 0; s < length; ++s) {
+    const VoxelPrimitive& p = prims[std::size_t(order[std::size_t(s)])];
+    design = p.mode == Mode::Additive ? unite(design, p.region) : subtract(design, p.region);
+  }
+  design = intersect(design, Solid::filled(kUnit, domain));
+  return make_problem(std::move(prims), design, domain);
+}
+
+TEST(Search, AStarFindsTheSameOptimaAsTheExhaustiveEnumerator) {
+  std::mt19937 rng(2018);
+  int solvable = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const int n = 2 + trial % 6;  // 2..7 primitives
+    VoxelProblem vp = random_instance(rng, n);
+    vp.problem.fixed = {trial % 3 == 0 ? 5.0 : 0.0, 0, trial % 4 == 0 ? 7.0 : 0.0};
+    for (auto& p : vp.problem.primitives) p.tool = "T" + std::to_string(rng() % 2);
+    const auto oracle = enumerate_plans(vp.problem);
+    SearchStats stats;
+    const auto found = find_plans(vp.problem, {5}, &stats);
+    ASSERT_EQ(found.size(), std::min<std::size_t>(5, oracle.size())) << "trial " << trial;
+    for (std::size_t i = 0; i < found.size(); ++i) {
+      EXPECT_NEAR(found[i].cost, oracle[i].cost, 1e-9 * std::max(1.0, oracle[i].cost)) << "trial " << trial << " plan " << i;
+      EXPECT_TRUE(is_goal(vp.problem, found[i].final_state));
+      // What the atoms promise is what the voxels give.
+      EXPECT_EQ(testing::evaluate(vp, found[i]), testing::atoms_union(vp, found[i].final_state)) << "trial " << trial;
+    }
+    std::set<std::vector<int>> distinct;
+    for (const Plan& p : found) {
+      std::vector<int> seq;
+      for (const PlanStep& s : p.steps) seq.push_back(s.primitive);
+      distinct.insert(seq);
+    }
+    EXPECT_EQ(distinct.size(), found.size());
+    solvable += !oracle.empty();
+  }
+  EXPECT_GT(solvable, 150);  // the generator really makes solvable instances
+}
+
+TEST(Search, PlansObeyC1ToC4) {
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 50; ++trial) {
+    const VoxelProblem vp = random_instance(rng, 5);
+    for (const Plan& plan : enumerate_plans(vp.problem)) {
+      ASSERT_FALSE(plan.steps.empty());
+      EXPECT_EQ(vp.problem.primitives[std::size_t(plan.steps[0].primitive)].mode, Mode::Additive);  // C3
+      std::set<int> used;
+      for (std::size_t s = 0; s < plan.steps.size(); ++s) {
+        const int i = plan.steps[s].primitive;
+        if (s > 0) {
+          EXPECT_FALSE(vp.problem.primitives[std::size_t(i)].raw_stock);  // C4
+        }
+        EXPECT_TRUE(used.insert(i).second);  // each primitive once by default
+        EXPECT_GT(plan.steps[s].volume, 0);  // no action that changes nothing
+      }
+    }
+  }
+}
+
+TEST(Search, ReuseUpToKTimesAgreesWithTheOracleToo) {
+  std::mt19937 rng(99);
+  int reused = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    VoxelProblem vp = random_instance(rng, 2 + trial % 3);
+    vp.problem.max_uses = 2;
+    const auto oracle = enumerate_plans(vp.problem);
+    const auto found = find_plans(vp.problem, {5});
+    ASSERT_EQ(found.size(), std::min<std::size_t>(5, oracle.size())) << "trial " << trial;
+    for (std::size_t i = 0; i < found.size(); ++i) {
+      EXPECT_NEAR(found[i].cost, oracle[i].cost, 1e-9 * std::max(1.0, oracle[i].cost)) << "trial " << trial;
+      EXPECT_EQ(testing::evaluate(vp, found[i]), testing::atoms_union(vp, found[i].final_state));
+    }
+    for (const Plan& p : oracle) {
+      std::multiset<int> uses;
+      for (const PlanStep& s : p.steps) uses.insert(s.primitive);
+      for (int i : uses) EXPECT_LE(uses.count(i), 2u);
+      for (int i : uses) reused += uses.count(i) == 2;
+    }
+  }
+  EXPECT_GT(reused, 0);  // reuse really occurs in these plans
+}
+
+TEST(Search, AnUnreachableDesignYieldsNoPlan) {
+  std::vector<VoxelPrimitive> prims = {{"A", Mode::Additive, false, 1.0, rect(0, 0, 4, 4)}};
+  const Solid design = rect(0, 0, 2, 2);  // a quarter of A: no primitive removes the rest
+  const VoxelProblem vp = make_problem(prims, design, {{0, 0, 0}, {4, 4, 1}});
+  SearchStats stats;
+  EXPECT_TRUE(find_plans(vp.problem, {5}, &stats).empty());
+  EXPECT_TRUE(stats.exhausted);
+  EXPECT_TRUE(enumerate_plans(vp.problem).empty());
+}
+
+}  // namespace
+}  // namespace hybridctl::planner
