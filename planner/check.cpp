@@ -1,0 +1,141 @@
+#include "planner/check.hpp"
+
+#include <algorithm>
+#include <cstdio>
+
+namespace hybridctl::planner {
+namespace {
+
+std::string format(const char* fmt, double a, double b = 0, double c = 0) {
+  char buf[128];
+  std::snprintf(buf, sizeof buf, fmt, a, b, c);
+  return buf;
+}
+
+std::string describe(const PlanningProblem& p, const ViolatingAtom& v) {
+  std::string s = "a " + format("%.3g", v.volume) + " mm\u00B3 region around " +
+                  format("(%.1f, %.1f, %.1f)", v.centroid.x, v.centroid.y, v.centroid.z) + " mm, " +
+                  format("%.3g", v.volume_in_design) + " mm\u00B3 of it inside the design and " +
+                  format("%.3g", v.volume - v.volume_in_design) + " mm\u00B3 outside; ";
+  bool any_additive = false, any_subtractive = false;
+  std::string names;
+  for (int i : v.primitives) {
+    const PrimitiveSpec& prim = p.primitives[std::size_t(i)];
+    (prim.mode == Mode::Additive ? any_additive : any_subtractive) = true;
+    names += (names.empty() ? "" : ", ") + prim.name;
+  }
+  if (v.primitives.empty()) {
+    s += "no primitive reaches it, so it stays empty";
+  } else {
+    s += "it lies in " + names + " and no other primitive splits it";
+    if (!any_subtractive) s += "; no removal reaches it";
+    if (!any_additive) s += "; no deposition reaches it";
+  }
+  return s;
+}
+
+// All-additive: the best outcome is the union of every primitive that deposits
+// nothing forbidden; it must cover every must-in atom.
+bool additive_only_possible(const PlanningProblem& p) {
+  const int m = int(p.atoms.size());
+  std::vector<bool> covered(std::size_t(m), false);
+  for (const PrimitiveSpec& prim : p.primitives) {
+    bool clean = true;
+    for (int a = 0; a < m && clean; ++a) clean = !(prim.atoms.test(a) && p.atoms[std::size_t(a)].must_out);
+    if (!clean) continue;
+    for (int a = 0; a < m; ++a) covered[std::size_t(a)] = covered[std::size_t(a)] || prim.atoms.test(a);
+  }
+  for (int a = 0; a < m; ++a)
+    if (p.atoms[std::size_t(a)].must_in && !covered[std::size_t(a)]) return false;
+  return true;
+}
+
+// Stock then removals: some additive start holds every must-in atom, and the removals
+// that spare every must-in atom clear every must-out atom it holds.
+bool subtractive_only_possible(const PlanningProblem& p) {
+  const int m = int(p.atoms.size());
+  std::vector<bool> removable(std::size_t(m), false);
+  for (const PrimitiveSpec& prim : p.primitives) {
+    if (prim.mode != Mode::Subtractive) continue;
+    bool spares = true;
+    for (int a = 0; a < m && spares; ++a) spares = !(prim.atoms.test(a) && p.atoms[std::size_t(a)].must_in);
+    if (!spares) continue;
+    for (int a = 0; a < m; ++a) removable[std::size_t(a)] = removable[std::size_t(a)] || prim.atoms.test(a);
+  }
+  for (const PrimitiveSpec& start : p.primitives) {
+    if (start.mode != Mode::Additive) continue;
+    bool ok = true;
+    for (int a = 0; a < m && ok; ++a) {
+      const AtomSpec& atom = p.atoms[std::size_t(a)];
+      if (atom.must_in && !start.atoms.test(a)) ok = false;
+      if (atom.must_out && start.atoms.test(a) && !removable[std::size_t(a)]) ok = false;
+    }
+    if (ok) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+Verdict check_manufacturability(const PlanningProblem& p, const std::vector<AtomMeasures>& measures,
+                                const Lattice& lattice) {
+  Verdict v;
+  int additive = 0, subtractive = 0, starts = 0;
+  for (const PrimitiveSpec& prim : p.primitives) {
+    if (prim.mode == Mode::Additive) {
+      ++additive;
+      starts += prim.raw_stock;
+    } else {
+      ++subtractive;
+    }
+  }
+  // A stock followed by removals is the subtractive-only process.
+  v.modality = subtractive == 0                          ? Modality::AdditiveOnly
+               : additive > 0 && additive == starts      ? Modality::SubtractiveOnly
+                                                         : Modality::Hybrid;
+  for (int a = 0; a < int(measures.size()); ++a) {
+    const AtomMeasures& m = measures[std::size_t(a)];
+    if (m.atom_class != AtomClass::Violating) continue;
+    ViolatingAtom va;
+    va.atom = a;
+    va.code = m.code.bits(int(p.primitives.size()));
+    for (int i = 0; i < int(p.primitives.size()); ++i)
+      if (m.code.test(i)) va.primitives.push_back(i);
+    va.volume = m.volume;
+    va.volume_in_design = m.volume_in_design;
+    va.bounds = lattice.extent(m.bounding_box);
+    va.centroid = m.centroid;
+    va.description = describe(p, va);
+    v.violations.push_back(std::move(va));
+  }
+  std::sort(v.violations.begin(), v.violations.end(),
+            [](const ViolatingAtom& x, const ViolatingAtom& y) { return x.volume > y.volume; });
+  if (!v.violations.empty()) {
+    v.manufacturable = false;
+    v.decided_without_search = true;
+    v.summary = "not manufacturable within tolerance: " + std::to_string(v.violations.size()) +
+                " atom" + (v.violations.size() == 1 ? "" : "s") + " straddle the design";
+    return v;
+  }
+  switch (v.modality) {
+    case Modality::AdditiveOnly:
+      v.decided_without_search = true;
+      v.manufacturable = additive_only_possible(p);
+      v.summary = v.manufacturable ? "manufacturable by deposition alone"
+                                   : "not manufacturable: the depositions cannot cover the design without overfill";
+      return v;
+    case Modality::SubtractiveOnly:
+      v.decided_without_search = true;
+      v.manufacturable = subtractive_only_possible(p);
+      v.summary = v.manufacturable ? "manufacturable from stock by removal alone"
+                                   : "not manufacturable: no stock and removals leave the design";
+      return v;
+    case Modality::Hybrid:
+      v.manufacturable = true;  // necessary condition holds; the search decides
+      v.summary = "no atom straddles the design; hybrid plans are searched";
+      return v;
+  }
+  return v;
+}
+
+}  // namespace hybridctl::planner

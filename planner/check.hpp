@@ -1,0 +1,42 @@
+#pragma once
+// The manufacturability check (paper section 6, Theorem 1 with a tolerance zone): a
+// verdict before any search, and for every atom that no plan can keep or drop as a
+// whole, where it is, how big, and which primitives hold it.
+
+#include <string>
+#include <vector>
+
+#include "planner/atoms.hpp"
+#include "planner/search.hpp"
+
+namespace hybridctl::planner {
+
+struct ViolatingAtom {
+  int atom = -1;
+  std::string code;                 // as the paper writes it, P1 first
+  std::vector<int> primitives;      // the primitives containing it
+  double volume = 0;                // mm^3
+  double volume_in_design = 0;      // mm^3
+  geometry::Box3 bounds;            // mm
+  Vec3 centroid;                    // mm
+  std::string description;          // one sentence for people
+};
+
+enum class Modality { AdditiveOnly, SubtractiveOnly, Hybrid };
+
+struct Verdict {
+  // False when some atom straddles the design beyond tolerance (no plan can make the
+  // part), or, for unimodal primitive sets, when no plan exists at all.
+  bool manufacturable = false;
+  // True when the answer was decided without search (violations, or unimodal sets).
+  bool decided_without_search = false;
+  Modality modality = Modality::Hybrid;
+  std::string summary;
+  std::vector<ViolatingAtom> violations;
+};
+
+// `problem` carries the primitives' names, modes and atom sets; `measures` the atoms.
+Verdict check_manufacturability(const PlanningProblem& problem, const std::vector<AtomMeasures>& measures,
+                                const Lattice& lattice);
+
+}  // namespace hybridctl::planner
