@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <map>
 #include <mutex>
@@ -23,6 +24,51 @@ std::int64_t clamp_extent(std::int64_t v) {
   return std::clamp<std::int64_t>(v, -kUnboundedExtent, kUnboundedExtent);
 }
 
+// Large scratch buffers are kept for the next call: on these machines first-touch page
+// faults cost more than the transforms themselves (about 2 s per GB). At most a few
+// buffers of each type are kept.
+template <typename T>
+class BufferPool {
+ public:
+  static BufferPool& instance() {
+    static BufferPool pool;
+    return pool;
+  }
+  std::vector<T> take(std::size_t n, T fill) {
+    std::vector<T> v;
+    {
+      std::lock_guard lock(mutex_);
+      // The smallest kept buffer that is big enough, else the biggest.
+      auto best = free_.end();
+      for (auto it = free_.begin(); it != free_.end(); ++it) {
+        if (best == free_.end()) {
+          best = it;
+          continue;
+        }
+        const bool fits = it->capacity() >= n, best_fits = best->capacity() >= n;
+        if ((fits && (!best_fits || it->capacity() < best->capacity())) || (!fits && !best_fits && it->capacity() > best->capacity()))
+          best = it;
+      }
+      if (best != free_.end()) {
+        v = std::move(*best);
+        free_.erase(best);
+      }
+    }
+    v.assign(n, fill);
+    return v;
+  }
+  void give(std::vector<T>&& v) {
+    if (v.capacity() == 0) return;
+    std::lock_guard lock(mutex_);
+    if (free_.size() < kKept) free_.push_back(std::move(v));
+  }
+
+ private:
+  static constexpr std::size_t kKept = 3;
+  std::mutex mutex_;
+  std::vector<std::vector<T>> free_;
+};
+
 // A dense box of values, x fastest.
 template <typename T>
 struct DenseGrid {
@@ -36,8 +82,11 @@ struct DenseGrid {
       ny = b.hi.y - b.lo.y;
       nz = b.hi.z - b.lo.z;
     }
-    values.assign(std::size_t(nx) * std::size_t(ny) * std::size_t(nz), fill);
+    values = BufferPool<T>::instance().take(std::size_t(nx) * std::size_t(ny) * std::size_t(nz), fill);
   }
+  DenseGrid(DenseGrid&&) = default;
+  DenseGrid& operator=(DenseGrid&&) = default;
+  ~DenseGrid() { BufferPool<T>::instance().give(std::move(values)); }
   std::size_t index(int x, int y, int z) const {  // grid-relative coordinates
     return (std::size_t(z) * std::size_t(ny) + std::size_t(y)) * std::size_t(nx) + std::size_t(x);
   }
@@ -48,13 +97,24 @@ struct DenseGrid {
   // Calls fn(first_index) for every line along `a`, in parallel.
   template <typename Fn>
   void for_each_line(Axis a, Fn fn) const {
+    for_each_line_block(a, [&](std::size_t first, int count) {
+      for (int j = 0; j < count; ++j) fn(first + std::size_t(j));
+    });
+  }
+  // Calls fn(first_index, count) for blocks of up to kBlock lines along `a` (a != X)
+  // that are neighbours along X, so a gather touches whole cache lines; along X every
+  // block is one contiguous line.
+  static constexpr int kBlock = 8;
+  template <typename Fn>
+  void for_each_line_block(Axis a, Fn fn) const {
     const Axis u = a == Axis::X ? Axis::Y : Axis::X;
     const Axis v = a == Axis::Z ? Axis::Y : Axis::Z;
     const int nu = size(u), nv = size(v);
     const std::size_t su = stride(u), sv = stride(v);
+    const int step = a == Axis::X ? 1 : kBlock;
     tbb::parallel_for(tbb::blocked_range<int>(0, nv), [&](const tbb::blocked_range<int>& r) {
       for (int j = r.begin(); j != r.end(); ++j)
-        for (int i = 0; i < nu; ++i) fn(std::size_t(i) * su + std::size_t(j) * sv);
+        for (int i = 0; i < nu; i += step) fn(std::size_t(i) * su + std::size_t(j) * sv, std::min(step, nu - i));
     });
   }
 };
@@ -66,67 +126,128 @@ DenseGrid<double> distance_seed(const Solid& solid, const IndexBox& box) {
   if (inside.empty()) return g;
   tbb::parallel_for(tbb::blocked_range<int>(inside.lo.z, inside.hi.z), [&](const tbb::blocked_range<int>& r) {
     for (int z = r.begin(); z != r.end(); ++z)
-      for (int y = inside.lo.y; y < inside.hi.y; ++y)
-        for (int x = inside.lo.x; x < inside.hi.x; ++x)
-          if (solid.contains({x, y, z})) g.values[g.index(x - box.lo.x, y - box.lo.y, z - box.lo.z)] = 0;
+      for (int y = inside.lo.y; y < inside.hi.y; ++y) {
+        double* line = g.values.data() + g.index(0, y - box.lo.y, z - box.lo.z) - box.lo.x;  // indexed by x
+        for (int w = inside.lo.x >> 6; w <= (inside.hi.x - 1) >> 6; ++w)
+          for (std::uint64_t bits = solid.word_at(w, y, z); bits; bits &= bits - 1) {
+            const int x = w * 64 + std::countr_zero(bits);
+            if (x >= inside.lo.x && x < inside.hi.x) line[x] = 0;
+          }
+      }
   });
   return g;
 }
 
-// One pass of the separable distance transform (Felzenszwalb & Huttenlocher): along
-// every line of `axis`, f(p) <- min_q f(q) + w (p - q)^2. Exact minimum of the computed
-// expressions: at each p the neighbouring parabolas of the envelope are checked too.
-void distance_pass(DenseGrid<double>& g, Axis axis, double w) {
+// The lower envelope of parabolas f(q) + w (p - q)^2 over one line (Felzenszwalb &
+// Huttenlocher), written back to `f`. Exact minimum of the computed expressions: at
+// each p the neighbouring parabolas of the envelope are checked too. Values above
+// `limit` become infinity: later passes only add to them and the caller thresholds.
+void envelope(double* f, int n, double w, double limit, std::vector<double>& z, std::vector<int>& v,
+              std::vector<double>& out) {
+  z.resize(std::size_t(n) + 1);
+  v.resize(std::size_t(n));
+  out.resize(std::size_t(n));
+  int k = -1;
+  for (int q = 0; q < n; ++q) {
+    if (f[q] == kInf) continue;
+    if (k < 0) {
+      k = 0;
+      v[0] = q;
+      z[0] = -kInf;
+      z[1] = kInf;
+      continue;
+    }
+    double s;
+    while (true) {
+      const int p = v[std::size_t(k)];
+      s = ((f[q] + w * double(q) * double(q)) - (f[p] + w * double(p) * double(p))) / (2.0 * w * double(q - p));
+      if (s <= z[std::size_t(k)] && k > 0) {
+        --k;
+      } else {
+        break;
+      }
+    }
+    ++k;
+    v[std::size_t(k)] = q;
+    z[std::size_t(k)] = s;
+    z[std::size_t(k) + 1] = kInf;
+  }
+  if (k < 0) return;  // nothing finite on this line
+  int j = 0;
+  for (int p = 0; p < n; ++p) {
+    while (z[std::size_t(j) + 1] < double(p)) ++j;
+    auto value = [&](int site) { return f[site] + w * double((p - site) * (p - site)); };
+    double best = value(v[std::size_t(j)]);
+    if (j > 0) best = std::min(best, value(v[std::size_t(j) - 1]));
+    if (j < k) best = std::min(best, value(v[std::size_t(j) + 1]));
+    out[std::size_t(p)] = best <= limit ? best : kInf;
+  }
+  std::copy(out.begin(), out.begin() + n, f);
+}
+
+// First pass over seeds (0 on the solid, infinity elsewhere): the distance to the
+// nearest seed on the line, by a sweep each way. Returns false when nothing changed.
+bool seed_distances(double* f, int n, double w, double limit, std::vector<int>& nearest) {
+  nearest.assign(std::size_t(n), -1);
+  int last = -1;
+  bool any_seed = false, any_gap = false;
+  for (int p = 0; p < n; ++p) {
+    if (f[p] == 0) {
+      last = p;
+      any_seed = true;
+    } else {
+      any_gap = true;
+    }
+    nearest[std::size_t(p)] = last;
+  }
+  if (!any_seed || !any_gap) return false;  // all air or all material: nothing moves
+  last = -1;
+  for (int p = n - 1; p >= 0; --p) {
+    if (f[p] == 0) last = p;
+    int d = INT32_MAX;
+    if (nearest[std::size_t(p)] >= 0) d = p - nearest[std::size_t(p)];
+    if (last >= 0) d = std::min(d, last - p);
+    const double value = w * double(d) * double(d);
+    f[p] = value <= limit ? value : kInf;
+  }
+  return true;
+}
+
+// One pass of the separable distance transform along `axis`:
+// f(p) <- min_q f(q) + w (p - q)^2. `seeds` says the grid still holds only 0 and
+// infinity (the first pass).
+void distance_pass(DenseGrid<double>& g, Axis axis, double w, double limit, bool seeds) {
   const int n = g.size(axis);
   const std::size_t stride = g.stride(axis);
-  g.for_each_line(axis, [&](std::size_t first) {
-    thread_local std::vector<double> f, z;
+  g.for_each_line_block(axis, [&](std::size_t first, int count) {
+    thread_local std::vector<double> buffer, z, out;
     thread_local std::vector<int> v;
-    f.resize(std::size_t(n));
-    v.resize(std::size_t(n));
-    z.resize(std::size_t(n) + 1);
-    int k = -1;
-    for (int q = 0; q < n; ++q) {
-      f[std::size_t(q)] = g.values[first + std::size_t(q) * stride];
-      if (f[std::size_t(q)] == kInf) continue;
-      if (k < 0) {
-        k = 0;
-        v[0] = q;
-        z[0] = -kInf;
-        z[1] = kInf;
+    buffer.resize(std::size_t(n) * std::size_t(count));
+    // Gather `count` neighbouring lines (one cache line per step), transform, scatter.
+    for (int q = 0; q < n; ++q)
+      for (int j = 0; j < count; ++j)
+        buffer[std::size_t(j) * std::size_t(n) + std::size_t(q)] = g.values[first + std::size_t(q) * stride + std::size_t(j)];
+    bool changed = false;
+    for (int j = 0; j < count; ++j) {
+      double* line = buffer.data() + std::size_t(j) * std::size_t(n);
+      if (seeds) {
+        changed |= seed_distances(line, n, w, limit, v);
         continue;
       }
-      double s;
-      while (true) {
-        const int p = v[std::size_t(k)];
-        s = ((f[std::size_t(q)] + w * double(q) * double(q)) - (f[std::size_t(p)] + w * double(p) * double(p))) /
-            (2.0 * w * double(q - p));
-        if (s <= z[std::size_t(k)] && k > 0) {
-          --k;
-        } else {
-          break;
-        }
+      // Lines wholly inside (all zero) or wholly outside (all infinite) stay as they are.
+      bool all_zero = true, all_inf = true;
+      for (int q = 0; q < n && (all_zero || all_inf); ++q) {
+        all_zero = all_zero && line[q] == 0;
+        all_inf = all_inf && line[q] == kInf;
       }
-      if (s <= z[std::size_t(k)]) {  // k == 0 and the new parabola is lower everywhere
-        v[0] = q;
-        z[1] = kInf;
-        continue;
-      }
-      ++k;
-      v[std::size_t(k)] = q;
-      z[std::size_t(k)] = s;
-      z[std::size_t(k) + 1] = kInf;
+      if (all_zero || all_inf) continue;
+      envelope(line, n, w, limit, z, v, out);
+      changed = true;
     }
-    if (k < 0) return;  // nothing finite on this line
-    int j = 0;
-    for (int p = 0; p < n; ++p) {
-      while (z[std::size_t(j) + 1] < double(p)) ++j;
-      auto value = [&](int site) { return f[std::size_t(site)] + w * double((p - site) * (p - site)); };
-      double best = value(v[std::size_t(j)]);
-      if (j > 0) best = std::min(best, value(v[std::size_t(j) - 1]));
-      if (j < k) best = std::min(best, value(v[std::size_t(j) + 1]));
-      g.values[first + std::size_t(p) * stride] = best;
-    }
+    if (!changed) return;
+    for (int q = 0; q < n; ++q)
+      for (int j = 0; j < count; ++j)
+        g.values[first + std::size_t(q) * stride + std::size_t(j)] = buffer[std::size_t(j) * std::size_t(n) + std::size_t(q)];
   });
 }
 
@@ -214,9 +335,15 @@ Solid dilate_axial(const Solid& solid, const AxialBody& body, const IndexBox& wo
   const double h = solid.voxel_size();
   const Axis a = body.direction.axis;
   DenseGrid<double> perp = distance_seed(solid, work);
-  for (Axis other : {Axis::X, Axis::Y, Axis::Z})
-    if (other != a) distance_pass(perp, other, 1.0);
   const AxialLevels levels = axial_levels(body, h);
+  double widest = levels.tail_radius_sq;
+  for (double r2 : levels.radius_sq) widest = std::max(widest, r2);
+  bool first_pass = true;
+  for (Axis other : {Axis::X, Axis::Y, Axis::Z}) {
+    if (other == a) continue;
+    distance_pass(perp, other, 1.0, widest, first_pass);
+    first_pass = false;
+  }
 
   // Group levels of equal radius into runs [lo, hi] so each radius is thresholded once.
   std::map<double, std::vector<std::pair<int, std::int64_t>>> runs;
@@ -472,15 +599,17 @@ Solid dilate(const Solid& solid, const StructuringElement& element, const IndexB
   const IndexBox work = box_union(source, domain);
   if (const auto* ball = std::get_if<Ball>(&element)) {
     DenseGrid<double> g = distance_seed(solid, work);
-    for (Axis a : {Axis::X, Axis::Y, Axis::Z}) distance_pass(g, a, 1.0);
     const double r = ball->radius / h;
+    distance_pass(g, Axis::X, 1.0, r * r, true);
+    distance_pass(g, Axis::Y, 1.0, r * r, false);
+    distance_pass(g, Axis::Z, 1.0, r * r, false);
     return threshold_into(g, r * r, solid.lattice(), domain);
   }
   if (const auto* e = std::get_if<Ellipsoid>(&element)) {
     DenseGrid<double> g = distance_seed(solid, work);
-    distance_pass(g, Axis::X, (h / e->radii.x) * (h / e->radii.x));
-    distance_pass(g, Axis::Y, (h / e->radii.y) * (h / e->radii.y));
-    distance_pass(g, Axis::Z, (h / e->radii.z) * (h / e->radii.z));
+    distance_pass(g, Axis::X, (h / e->radii.x) * (h / e->radii.x), 1.0, true);
+    distance_pass(g, Axis::Y, (h / e->radii.y) * (h / e->radii.y), 1.0, false);
+    distance_pass(g, Axis::Z, (h / e->radii.z) * (h / e->radii.z), 1.0, false);
     return threshold_into(g, 1.0, solid.lattice(), domain);
   }
   if (const auto* body = std::get_if<AxialBody>(&element)) return dilate_axial(solid, *body, work, domain);

@@ -1,0 +1,329 @@
+#pragma once
+// The machine model: what a hybrid (deposition + milling) machine can do, as plain values.
+//
+// Everything here is filled by config::parse_machine / load_machine from a machine file
+// (docs/machine-file.md is the key-by-key reference). The default member values below are
+// the documented defaults the loader applies when a key is absent. Units throughout:
+// mm, s, degrees; feeds in mm/min (rotary: deg/min), accelerations in mm/s² (deg/s²),
+// spindle speeds in rpm, volumes in mm³.
+
+#include <array>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace hybridctl::config {
+
+/// A closed interval [min, max]; the loader guarantees min < max.
+struct Range {
+  double min = 0.0;
+  double max = 0.0;
+
+  double span() const { return max - min; }
+  bool contains(double v) const { return v >= min && v <= max; }
+};
+
+/// One linear axis of the machine frame (Z up the spindle).
+struct LinearAxis {
+  Range travel;                         ///< mm, machine frame; required
+  double max_feed = 5000.0;             ///< mm/min
+  double max_acceleration = 500.0;      ///< mm/s²
+};
+
+/// One rotary axis (A about X, B about Y, C about Z).
+struct RotaryAxis {
+  char name = 'B';                      ///< 'A', 'B' or 'C'
+  Range range;                          ///< degrees; required
+  double max_feed = 3600.0;             ///< deg/min
+  double max_acceleration = 360.0;      ///< deg/s²
+};
+
+/// Where the tool can go.
+struct Envelope {
+  LinearAxis x, y, z;
+  std::vector<RotaryAxis> rotary;       ///< in A, B, C order; empty for a 3-axis machine
+
+  const RotaryAxis* find_rotary(char axis_name) const {
+    for (const auto& a : rotary)
+      if (a.name == axis_name) return &a;
+    return nullptr;
+  }
+};
+
+/// The kinds of primitive the planner may derive from a head or a tool
+/// (ARCHITECTURE.md, "The planning core").
+enum class PrimitiveKind {
+  UAm,     ///< "u-am": maximal depositable region inside the design
+  OAm,     ///< "o-am": conservative overfill
+  SmMax,   ///< "sm-max": maximal removable region that never cuts the design
+  SmCons,  ///< "sm-cons": conservative over-cut
+};
+
+enum class DepositionProcess { DedPowder, DedWire, WireArc, LaserWire };
+enum class BeadShape { Ellipsoid, Cylinder };
+
+/// The cross-section one pass deposits: the head's minimum manufacturable neighbourhood.
+struct Bead {
+  BeadShape shape = BeadShape::Ellipsoid;
+  double width = 0.0;                   ///< mm, > 0; required
+  double height = 0.0;                  ///< mm, > 0; required
+};
+
+/// The non-cutting body around the deposition point, used for clearance.
+struct Nozzle {
+  double diameter = 0.0;                ///< mm, > 0
+  double length = 0.0;                  ///< mm, > 0
+};
+
+/// Machine codes that switch deposition. `power_template` contains "{power}", which the
+/// post-processor replaces by `power`.
+struct DepositionCodes {
+  std::string on = "M64 P0";            ///< LinuxCNC: digital output 0 on
+  std::string off = "M65 P0";           ///< LinuxCNC: digital output 0 off
+  std::optional<std::string> power_template;  ///< e.g. "M68 E0 Q{power}"; none by default
+  double power = 0.0;                   ///< the value substituted for {power}; >= 0
+};
+
+/// A deposition head.
+struct AdditiveHead {
+  std::string name;                     ///< unique among heads; required
+  DepositionProcess process = DepositionProcess::DedPowder;  ///< required
+  Bead bead;                            ///< required
+  std::optional<Nozzle> nozzle;         ///< none: the head body is ignored for clearance
+  double layer_height = 0.0;            ///< mm, 0 < h <= bead.height; default 0.8 x bead.height
+  double hatch_spacing = 0.0;           ///< mm, 0 < s <= bead.width; default 0.7 x bead.width
+  double travel_clearance = 5.0;        ///< mm lifted for travel moves, >= 0
+  double feed = 1000.0;                 ///< mm/min while depositing
+  DepositionCodes codes;
+  double cost_per_mm3 = 1.0;            ///< cost factor per mm³ deposited, >= 0
+  std::vector<PrimitiveKind> primitives = {PrimitiveKind::UAm, PrimitiveKind::OAm};
+
+  bool offers(PrimitiveKind k) const {
+    for (auto p : primitives)
+      if (p == k) return true;
+    return false;
+  }
+};
+
+/// Fractions that derive a head's layer height and hatch spacing from its bead when the
+/// machine file does not give them.
+inline constexpr double kDefaultLayerHeightFraction = 0.8;
+inline constexpr double kDefaultHatchSpacingFraction = 0.7;
+
+enum class ToolType { Flat, Ball, Bull };
+
+/// A cylinder of the tool's non-cutting body (shank or holder).
+struct ToolBody {
+  double diameter = 0.0;                ///< mm, > 0
+  double length = 0.0;                  ///< mm, > 0
+};
+
+/// A cutting tool (end mill) in the magazine.
+struct CuttingTool {
+  int number = 0;                       ///< T number, > 0, unique; required
+  std::string name;                     ///< unique among tools; default "T<number>"
+  ToolType type = ToolType::Flat;       ///< required
+  double diameter = 0.0;                ///< mm, > 0; required
+  double corner_radius = 0.0;           ///< mm; flat 0, ball diameter/2, bull 0 < r < diameter/2
+  double flute_length = 0.0;            ///< mm, > 0; default 3 x diameter
+  ToolBody shank;                       ///< default {diameter, 2 x diameter}
+  ToolBody holder = {50.0, 60.0};       ///< default {50, 60}
+  double spindle_speed = 10000.0;       ///< rpm, > 0
+  double feed = 1000.0;                 ///< mm/min, > 0
+  double plunge_feed = 300.0;           ///< mm/min, > 0
+  double step_down = 0.0;               ///< mm, 0 < d <= flute_length; default 0.5 x diameter
+  double step_over = 0.0;               ///< mm, 0 < s <= diameter; default 0.4 x diameter
+  double cost_per_mm3 = 1.0;            ///< cost factor per mm³ removed, >= 0
+  std::vector<PrimitiveKind> primitives = {PrimitiveKind::SmMax, PrimitiveKind::SmCons};
+
+  /// Flute + shank + holder: how far the tool assembly reaches below the spindle nose.
+  double stick_out() const { return flute_length + shank.length + holder.length; }
+  bool offers(PrimitiveKind k) const {
+    for (auto p : primitives)
+      if (p == k) return true;
+    return false;
+  }
+};
+
+/// The direction the tool comes from, in the part frame ("+Z" = from above).
+enum class Approach { PlusX, MinusX, PlusY, MinusY, PlusZ, MinusZ };
+
+/// A rotary axis position held during a setup.
+struct RotaryPosition {
+  char axis = 'B';
+  double degrees = 0.0;
+};
+
+/// One fixturing of the part.
+struct Setup {
+  std::string name;                     ///< unique; required
+  std::string description;
+  Approach approach = Approach::PlusZ;
+  int work_offset = 54;                 ///< 54..59 for G54..G59
+  bool manual_refixture = false;        ///< the operator re-clamps the part before this setup
+  std::vector<RotaryPosition> rotary;   ///< axes not listed are not commanded
+
+  std::optional<double> rotary_position(char axis) const {
+    for (const auto& r : rotary)
+      if (r.axis == axis) return r.degrees;
+    return std::nullopt;
+  }
+};
+
+enum class Axis { X, Y, Z };
+
+/// A raw stock: a box around the part's bounding box, or a round bar.
+struct RawStock {
+  enum class Kind { Box, RoundBar };
+  std::string name;                     ///< unique; required
+  Kind kind = Kind::Box;
+  std::array<double, 3> margin = {1.0, 1.0, 1.0};  ///< box: mm added on each side in X, Y, Z, >= 0
+  double bar_diameter = 0.0;            ///< round bar: mm, > 0
+  double bar_length = 0.0;              ///< round bar: mm, > 0
+  Axis bar_axis = Axis::Z;              ///< round bar: its axis in the part frame
+};
+
+/// Planner tunables and fixed costs.
+struct Planning {
+  double voxel_size = 0.5;              ///< mm, > 0
+  double tolerance = 0.5;               ///< mm, >= 0
+  double sliver_threshold = 1.0;        ///< mm³, >= 0: smaller atoms are noise
+  int top_k = 5;                        ///< plans returned, >= 1
+  double tool_change_cost = 0.0;        ///< >= 0
+  double setup_change_cost = 0.0;       ///< >= 0
+  double mode_switch_cost = 0.0;        ///< AM <-> SM, >= 0
+};
+
+enum class TransportKind { ModbusTcp, ModbusRtu, SocketCan, Socketcand };
+
+/// A connection to the machine's controller, parsed from a URI:
+///   modbus-tcp://HOST:PORT[?unit=N]
+///   modbus-rtu:///dev/DEVICE[?baud=B&parity=N|E|O&unit=N]
+///   socketcan://IFACE[?node=N]
+///   socketcand://HOST:PORT/CHANNEL[?node=N]
+struct Transport {
+  std::string name;                     ///< the key in `transports`
+  std::string uri;                      ///< as written
+  TransportKind kind = TransportKind::ModbusTcp;
+  std::string host;                     ///< modbus-tcp, socketcand
+  int port = 0;                         ///< modbus-tcp, socketcand: 1..65535
+  std::string device;                   ///< modbus-rtu: absolute path of the serial device
+  int baud = 19200;                     ///< modbus-rtu
+  char parity = 'E';                    ///< modbus-rtu: 'N', 'E' or 'O'
+  int unit = 1;                         ///< modbus: unit (slave) id, TCP 0..255, RTU 1..247
+  std::string interface_name;           ///< socketcan: network interface, e.g. "can0"
+  std::string channel;                  ///< socketcand: bus name on the remote host
+  int node = 1;                         ///< socketcan, socketcand: node id 1..127
+};
+
+enum class Dialect { Rs274ngc, Fanuc };
+
+/// Overridable M codes. program_end defaults to M2 for rs274ngc and M30 for fanuc.
+struct MCodes {
+  std::string program_stop = "M0";
+  std::string optional_stop = "M1";
+  std::string program_end = "M2";
+  std::string spindle_cw = "M3";
+  std::string spindle_ccw = "M4";
+  std::string spindle_stop = "M5";
+  std::string tool_change = "M6";
+  std::string coolant_on = "M8";
+  std::string coolant_off = "M9";
+};
+
+struct GcodeSettings {
+  Dialect dialect = Dialect::Rs274ngc;
+  int program_number = 1000;            ///< fanuc O number, 1..9999
+  MCodes m_codes;
+};
+
+/// The whole machine.
+struct Machine {
+  std::string name;                     ///< required
+  std::string description;
+  Envelope envelope;                    ///< required
+  std::vector<AdditiveHead> heads;      ///< heads + tools: at least one in all
+  std::vector<CuttingTool> tools;
+  std::vector<Setup> setups;            ///< at least one
+  std::vector<RawStock> raw_stocks = {RawStock{.name = "box"}};  ///< default: one box, margin 1 mm
+  Planning planning;
+  std::vector<Transport> transports;    ///< in file order
+  GcodeSettings gcode;
+
+  const CuttingTool* find_tool(int number) const {
+    for (const auto& t : tools)
+      if (t.number == number) return &t;
+    return nullptr;
+  }
+  const AdditiveHead* find_head(std::string_view head_name) const {
+    for (const auto& h : heads)
+      if (h.name == head_name) return &h;
+    return nullptr;
+  }
+  const Setup* find_setup(std::string_view setup_name) const {
+    for (const auto& s : setups)
+      if (s.name == setup_name) return &s;
+    return nullptr;
+  }
+  const Transport* find_transport(std::string_view transport_name) const {
+    for (const auto& t : transports)
+      if (t.name == transport_name) return &t;
+    return nullptr;
+  }
+};
+
+// Names as written in the machine file.
+constexpr std::string_view to_string(PrimitiveKind k) {
+  switch (k) {
+    case PrimitiveKind::UAm: return "u-am";
+    case PrimitiveKind::OAm: return "o-am";
+    case PrimitiveKind::SmMax: return "sm-max";
+    case PrimitiveKind::SmCons: return "sm-cons";
+  }
+  return "?";
+}
+constexpr std::string_view to_string(DepositionProcess p) {
+  switch (p) {
+    case DepositionProcess::DedPowder: return "ded-powder";
+    case DepositionProcess::DedWire: return "ded-wire";
+    case DepositionProcess::WireArc: return "wire-arc";
+    case DepositionProcess::LaserWire: return "laser-wire";
+  }
+  return "?";
+}
+constexpr std::string_view to_string(BeadShape s) {
+  return s == BeadShape::Ellipsoid ? "ellipsoid" : "cylinder";
+}
+constexpr std::string_view to_string(ToolType t) {
+  switch (t) {
+    case ToolType::Flat: return "flat";
+    case ToolType::Ball: return "ball";
+    case ToolType::Bull: return "bull";
+  }
+  return "?";
+}
+constexpr std::string_view to_string(Approach a) {
+  switch (a) {
+    case Approach::PlusX: return "+X";
+    case Approach::MinusX: return "-X";
+    case Approach::PlusY: return "+Y";
+    case Approach::MinusY: return "-Y";
+    case Approach::PlusZ: return "+Z";
+    case Approach::MinusZ: return "-Z";
+  }
+  return "?";
+}
+constexpr std::string_view to_string(Axis a) { return a == Axis::X ? "X" : a == Axis::Y ? "Y" : "Z"; }
+constexpr std::string_view to_string(TransportKind k) {
+  switch (k) {
+    case TransportKind::ModbusTcp: return "modbus-tcp";
+    case TransportKind::ModbusRtu: return "modbus-rtu";
+    case TransportKind::SocketCan: return "socketcan";
+    case TransportKind::Socketcand: return "socketcand";
+  }
+  return "?";
+}
+constexpr std::string_view to_string(Dialect d) { return d == Dialect::Rs274ngc ? "rs274ngc" : "fanuc"; }
+
+}  // namespace hybridctl::config

@@ -1,0 +1,24 @@
+#pragma once
+// Loading a machine file (YAML) into config::Machine, reporting every problem in one pass
+// as "file:line:column: what is wrong, what was expected". docs/machine-file.md is the
+// reference for the file format.
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+#include "config/diagnostic.hpp"
+#include "config/machine.hpp"
+#include "config/summary.hpp"
+
+namespace hybridctl::config {
+
+/// Reads and parses `path`. An unreadable file is one diagnostic "path: cannot read: <reason>".
+/// Throws MachineFileError (and nothing else) on any problem.
+Machine load_machine(const std::filesystem::path& path);
+
+/// Parses `yaml_text`; `file_name` is used in diagnostics only.
+/// Throws MachineFileError (and nothing else) on any problem.
+Machine parse_machine(std::string_view yaml_text, std::string file_name);
+
+}  // namespace hybridctl::config
