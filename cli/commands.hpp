@@ -9,7 +9,7 @@
 namespace hybridctl::cli {
 
 // Exit codes, documented in `hybridctl --help` and the README.
-enum ExitCode : int { kSuccess = 0, kInternalError = 1, kUsage = 2, kBadInput = 3 };
+enum ExitCode : int { kSuccess = 0, kInternalError = 1, kUsage = 2, kBadInput = 3, kNotManufacturable = 4 };
 
 using Runner = std::function<int()>;
 
@@ -17,5 +17,6 @@ using Runner = std::function<int()>;
 void add_machine_command(CLI::App& app, Runner& runner);
 void add_voxelize_command(CLI::App& app, Runner& runner);
 void add_inspect_command(CLI::App& app, Runner& runner);
+void add_plan_command(CLI::App& app, Runner& runner);
 
 }  // namespace hybridctl::cli

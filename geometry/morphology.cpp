@@ -643,3 +643,24 @@ Solid close(const Solid& solid, const StructuringElement& element, MorphologyMet
 }
 
 }  // namespace hybridctl::geometry
+
+namespace hybridctl::geometry {
+
+double farthest_distance(const Solid& from, const Solid& to) {
+  const IndexBox fb = from.bounding_box();
+  if (fb.empty()) return 0;
+  const IndexBox tb = to.bounding_box();
+  if (tb.empty()) return std::numeric_limits<double>::infinity();
+  const IndexBox work = box_union(fb, tb);
+  DenseGrid<double> g = distance_seed(to, work);
+  distance_pass(g, Axis::X, 1.0, kInf, true);
+  distance_pass(g, Axis::Y, 1.0, kInf, false);
+  distance_pass(g, Axis::Z, 1.0, kInf, false);
+  double worst = 0;
+  from.for_each_voxel([&](Index3 v) {
+    worst = std::max(worst, g.values[g.index(v.x - work.lo.x, v.y - work.lo.y, v.z - work.lo.z)]);
+  });
+  return std::sqrt(worst) * from.voxel_size();
+}
+
+}  // namespace hybridctl::geometry

@@ -102,3 +102,11 @@ inline constexpr int kUnboundedExtent = 1 << 28;
 IndexBox element_extent(const StructuringElement& element, double voxel_size);
 
 }  // namespace hybridctl::geometry
+
+namespace hybridctl::geometry {
+
+// The largest distance (mm, between voxel centres) from a voxel of `from` to the
+// nearest voxel of `to`; 0 when `from` is empty, infinity when `to` is empty.
+double farthest_distance(const Solid& from, const Solid& to);
+
+}  // namespace hybridctl::geometry

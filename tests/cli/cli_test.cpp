@@ -18,7 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Run {
+struct Outcome {
   int exit_code = -1;
   std::string out, err;
 };
@@ -45,12 +45,12 @@ class Cli : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  Run run(const std::vector<std::string>& args) {
+  Outcome run(const std::vector<std::string>& args) {
     std::string cmd = quote(HYBRIDCTL_EXE);
     for (const auto& a : args) cmd += " " + quote(a);
     cmd += " >" + quote((dir_ / "stdout").string()) + " 2>" + quote((dir_ / "stderr").string()) + " </dev/null";
     const int status = std::system(cmd.c_str());
-    Run r;
+    Outcome r;
     r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
     r.out = slurp(dir_ / "stdout");
     r.err = slurp(dir_ / "stderr");
@@ -70,7 +70,7 @@ const std::string kBracket = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/part
 TEST_F(Cli, EverySubcommandHasHelp) {
   for (auto args : std::vector<std::vector<std::string>>{
            {"--help"}, {"machine", "--help"}, {"machine", "check", "--help"}, {"voxelize", "--help"}, {"inspect", "--help"}}) {
-    const Run r = run(args);
+    const Outcome r = run(args);
     EXPECT_EQ(r.exit_code, 0) << args[0];
     EXPECT_NE(r.out.find("Usage"), std::string::npos) << r.out;
   }
@@ -80,14 +80,14 @@ TEST_F(Cli, UsageErrorsExitWithTwo) {
   EXPECT_EQ(run({}).exit_code, 2);
   EXPECT_EQ(run({"frobnicate"}).exit_code, 2);
   EXPECT_EQ(run({"voxelize", kBracket}).exit_code, 2);  // -o missing
-  const Run negative = run({"voxelize", kBracket, "--voxel", "-1", "-o", (dir_ / "x.vdb").string()});
+  const Outcome negative = run({"voxelize", kBracket, "--voxel", "-1", "-o", (dir_ / "x.vdb").string()});
   EXPECT_EQ(negative.exit_code, 2);
   EXPECT_NE(negative.err.find("--voxel"), std::string::npos) << negative.err;
   EXPECT_FALSE(fs::exists(dir_ / "x.vdb"));
 }
 
 TEST_F(Cli, VoxelizesThePartAndWritesTheVdbAndSlices) {
-  const Run r = run({"voxelize", kBracket, "--voxel", "1", "-o", (dir_ / "b.vdb").string(), "--png-slices",
+  const Outcome r = run({"voxelize", kBracket, "--voxel", "1", "-o", (dir_ / "b.vdb").string(), "--png-slices",
                      (dir_ / "slices").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("volume"), std::string::npos) << r.out;
@@ -96,13 +96,13 @@ TEST_F(Cli, VoxelizesThePartAndWritesTheVdbAndSlices) {
   EXPECT_GT(solid.voxel_count(), 1000);
   const auto layers = solid.bounding_box().hi.z - solid.bounding_box().lo.z;
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_ / "slices"), fs::directory_iterator{}), layers);
-  const Run inspect = run({"inspect", (dir_ / "b.vdb").string()});
+  const Outcome inspect = run({"inspect", (dir_ / "b.vdb").string()});
   EXPECT_EQ(inspect.exit_code, 0) << inspect.err;
   EXPECT_NE(inspect.out.find(std::to_string(solid.voxel_count())), std::string::npos) << inspect.out;
 }
 
 TEST_F(Cli, InspectsAMesh) {
-  const Run r = run({"inspect", kBracket});
+  const Outcome r = run({"inspect", kBracket});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("closed       yes"), std::string::npos) << r.out;
 }
@@ -140,7 +140,7 @@ TEST_F(Cli, EachBadStlKindGetsItsOwnMessageAndExitCodeThree) {
   for (const BadStl& c : cases) {
     const fs::path input = write(c.name, c.bytes);
     const fs::path output = dir_ / (std::string(c.name) + ".vdb");
-    const Run r = run({"voxelize", input.string(), "-o", output.string()});
+    const Outcome r = run({"voxelize", input.string(), "-o", output.string()});
     EXPECT_EQ(r.exit_code, 3) << c.name << ": " << r.err;
     EXPECT_NE(r.err.find(c.says), std::string::npos) << c.name << ": " << r.err;
     EXPECT_NE(r.err.find(input.string()), std::string::npos) << c.name << " message does not name the file: " << r.err;
@@ -149,18 +149,18 @@ TEST_F(Cli, EachBadStlKindGetsItsOwnMessageAndExitCodeThree) {
 }
 
 TEST_F(Cli, AnOutputDirectoryThatDoesNotExistIsBadInputAndNothingIsWritten) {
-  const Run r = run({"voxelize", kBracket, "--voxel", "2", "-o", (dir_ / "nope" / "b.vdb").string()});
+  const Outcome r = run({"voxelize", kBracket, "--voxel", "2", "-o", (dir_ / "nope" / "b.vdb").string()});
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_NE(r.err.find("does not exist"), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, MachineCheckAcceptsTheExamplesAndPointsAtEveryProblem) {
   for (const char* machine : {"hybrid-3axis.yaml", "multitask-b-axis.yaml"}) {
-    const Run ok = run({"machine", "check", std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/" + machine});
+    const Outcome ok = run({"machine", "check", std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/" + machine});
     EXPECT_EQ(ok.exit_code, 0) << machine << ": " << ok.err;
   }
   const fs::path bad = write("bad.yaml", "name: broken\nenvelope:\n  x: [0, 100]\n  y: [0, 100]\n  z: [0, 100]\nfrobnicate: 3\n");
-  const Run r = run({"machine", "check", bad.string()});
+  const Outcome r = run({"machine", "check", bad.string()});
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_NE(r.err.find(bad.string() + ":6:1:"), std::string::npos) << r.err;
 }

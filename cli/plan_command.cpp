@@ -1,0 +1,95 @@
+#include <cstdio>
+#include <memory>
+
+#include "cli/commands.hpp"
+#include "cli/progress.hpp"
+#include "common/error.hpp"
+#include "config/machine_loader.hpp"
+#include "planner/plan_report.hpp"
+
+namespace hybridctl::cli {
+namespace {
+
+struct PlanArgs {
+  std::string part;
+  std::string machine;
+  std::string output;
+  double voxel = 0;
+  double tolerance = -1;
+  int top = 0;
+  int reuse = 1;
+  std::vector<std::string> primitive_files;
+};
+
+planner::PrimitiveFile parse_primitive_argument(const std::string& arg) {
+  const auto colon = arg.rfind(':');
+  const std::string mode = colon == std::string::npos ? "" : arg.substr(colon + 1);
+  if (mode != "am" && mode != "sm") {
+    throw InputError("--primitive " + arg + ": expected FILE:am or FILE:sm (additive or subtractive)");
+  }
+  return {arg.substr(0, colon), mode == "am" ? planner::Mode::Additive : planner::Mode::Subtractive, 1.0};
+}
+
+int run_plan(const PlanArgs& args) {
+  const config::Machine machine = config::load_machine(args.machine);
+  planner::PlanningOptions options;
+  options.voxel_size = args.voxel;
+  options.tolerance = args.tolerance;
+  options.top_k = args.top;
+  options.max_uses = args.reuse;
+  for (const std::string& p : args.primitive_files) options.extra_primitives.push_back(parse_primitive_argument(p));
+  ProgressBar bar("planning");
+  std::string current;
+  options.progress = [&](const std::string& phase, double f) {
+    // One bar across the phases, weighted by their usual share of the time.
+    static const std::pair<const char*, std::pair<double, double>> weights[] = {
+        {"voxelize", {0.0, 0.1}}, {"primitives", {0.1, 0.7}}, {"atoms", {0.7, 0.85}}, {"search", {0.85, 1.0}}};
+    for (const auto& [name, span] : weights)
+      if (phase == name) bar.update(span.first + f * (span.second - span.first));
+  };
+  const geometry::TriangleMesh mesh = geometry::read_stl(args.part);
+  const planner::PlanningResult result = planner::plan_part(mesh, args.part, machine, options);
+  bar.finish();
+  const planner::ReportSources sources{args.part, args.machine, machine.name};
+  std::fputs(planner::plan_summary(result, sources).c_str(), stdout);
+  if (!args.output.empty()) {
+    planner::write_plan_directory(result, sources, args.output);
+    std::printf("wrote       %s/plan.json, design.vdb, %zu primitive and %zu plan .vdb files\n", args.output.c_str(),
+                result.primitives.size(), result.plans.size());
+  }
+  std::printf("time       ");
+  double total = 0;
+  for (const auto& [phase, seconds] : result.timings) {
+    std::printf(" %s %.2f s,", phase.c_str(), seconds);
+    total += seconds;
+  }
+  std::printf(" total %.2f s\n", total);
+  return result.verdict.manufacturable && !result.plans.empty() ? int(kSuccess) : int(kNotManufacturable);
+}
+
+}  // namespace
+
+void add_plan_command(CLI::App& app, Runner& runner) {
+  auto args = std::make_shared<PlanArgs>();
+  auto* cmd = app.add_subcommand("plan",
+                                 "Find cost-optimal hybrid plans for a part on a machine: primitives, atoms, "
+                                 "manufacturability verdict and the k best plans (exit 4 when not manufacturable)");
+  cmd->add_option("PART", args->part, "Part mesh (closed STL, mm)")->required();
+  cmd->add_option("-m,--machine", args->machine, "Machine description (YAML)")->required();
+  cmd->add_option("-o,--output", args->output,
+                  "Write plan.json and .vdb files of the design, primitives and plans into this directory");
+  cmd->add_option("--voxel", args->voxel, "Voxel size in mm (default: the machine file's planning.voxel_size)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--tolerance", args->tolerance, "Tolerance in mm (default: the machine file's planning.tolerance)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--top", args->top, "How many plans (default: the machine file's planning.top_k)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--reuse", args->reuse, "How often one primitive may appear in a plan")
+      ->default_val(1)
+      ->check(CLI::Range(1, 8));
+  cmd->add_option("--primitive", args->primitive_files,
+                  "Extra primitive FILE:am or FILE:sm (STL, or .vdb on the plan's voxel grid); repeatable");
+  cmd->callback([&runner, args] { runner = [args] { return run_plan(*args); }; });
+}
+
+}  // namespace hybridctl::cli

@@ -1,0 +1,181 @@
+#include "planner/machine_primitives.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "geometry/shapes.hpp"
+#include "planner/primitive_shapes.hpp"
+
+namespace hybridctl::planner {
+namespace {
+
+using geometry::AxialBody;
+using geometry::AxialSection;
+using geometry::AxisDirection;
+using geometry::Solid;
+
+AxisDirection direction_of(config::Approach a) {
+  switch (a) {
+    case config::Approach::PlusX: return {geometry::Axis::X, +1};
+    case config::Approach::MinusX: return {geometry::Axis::X, -1};
+    case config::Approach::PlusY: return {geometry::Axis::Y, +1};
+    case config::Approach::MinusY: return {geometry::Axis::Y, -1};
+    case config::Approach::PlusZ: return {geometry::Axis::Z, +1};
+    case config::Approach::MinusZ: return {geometry::Axis::Z, -1};
+  }
+  return {};
+}
+
+std::string setup_words(const config::Setup& s) {
+  return "from " + std::string(config::to_string(s.approach)) + " (" + s.name + ")";
+}
+
+}  // namespace
+
+const char* to_string(PrimitiveKind k) {
+  switch (k) {
+    case PrimitiveKind::RawStock: return "raw-stock";
+    case PrimitiveKind::UAm: return "u-am";
+    case PrimitiveKind::OAm: return "o-am";
+    case PrimitiveKind::SmMax: return "sm-max";
+    case PrimitiveKind::SmCons: return "sm-cons";
+    case PrimitiveKind::File: return "file";
+  }
+  return "?";
+}
+
+Instrument bead_instrument(const config::AdditiveHead& head, config::Approach approach) {
+  const AxisDirection d = direction_of(approach);
+  const double w = head.bead.width / 2, h = head.bead.height / 2;
+  Instrument in;
+  if (head.bead.shape == config::BeadShape::Ellipsoid) {
+    geometry::Vec3 radii{w, w, w};
+    (d.axis == geometry::Axis::X ? radii.x : d.axis == geometry::Axis::Y ? radii.y : radii.z) = h;
+    in.cutting.push_back(geometry::Ellipsoid{radii});
+  } else {
+    in.cutting.push_back(geometry::cylinder_body(d, w, head.bead.height));
+  }
+  // Deposition builds layer on layer from below the nozzle: the nozzle body constrains
+  // the toolpath's clearance moves, not the depositable shape (ARCHITECTURE.md).
+  return in;
+}
+
+Instrument tool_instrument(const config::CuttingTool& tool, config::Approach approach) {
+  const AxisDirection d = direction_of(approach);
+  const double r = tool.diameter / 2, flute = tool.flute_length;
+  AxialBody cutting{d, {}};
+  switch (tool.type) {
+    case config::ToolType::Flat:
+      cutting.sections.push_back({AxialSection::Kind::Cylinder, 0, flute, r, 0, 0});
+      break;
+    case config::ToolType::Ball:
+      cutting.sections.push_back({AxialSection::Kind::Sphere, 0, r, r, r, 0});
+      cutting.sections.push_back({AxialSection::Kind::Cylinder, r, flute, r, 0, 0});
+      break;
+    case config::ToolType::Bull: {
+      const double rc = tool.corner_radius;
+      cutting.sections.push_back({AxialSection::Kind::Torus, 0, rc, rc, rc, r - rc});
+      cutting.sections.push_back({AxialSection::Kind::Cylinder, rc, flute, r, 0, 0});
+      break;
+    }
+  }
+  // Shank, then the holder; above the holder the spindle: the body never ends, so
+  // whatever lies in its shadow is out of reach.
+  const double shank_end = flute + tool.shank.length;
+  AxialBody body{d,
+                 {{AxialSection::Kind::Cylinder, flute, shank_end, tool.shank.diameter / 2, 0, 0},
+                  {AxialSection::Kind::Cylinder, shank_end, std::numeric_limits<double>::infinity(),
+                   tool.holder.diameter / 2, 0, 0}}};
+  Instrument in;
+  in.cutting.push_back(cutting);
+  in.body.push_back(body);
+  return in;
+}
+
+std::vector<Primitive> machine_primitives(const config::Machine& m, const Solid& design,
+                                          const geometry::IndexBox& domain, const PrimitiveProgress& progress) {
+  std::vector<Primitive> out;
+  const geometry::Lattice& lattice = design.lattice();
+  const geometry::Box3 bb = design.bounding_box_mm();
+  std::size_t total = m.raw_stocks.size();
+  for (const auto& head : m.heads) total += m.setups.size() * head.primitives.size();
+  for (const auto& tool : m.tools) total += m.setups.size() * tool.primitives.size();
+  auto add = [&](Primitive p, const std::function<Solid()>& make) {
+    if (progress) progress(out.size(), total, p.label);
+    p.region = make();
+    p.name = "P" + std::to_string(out.size() + 1);
+    out.push_back(std::move(p));
+  };
+
+  for (const auto& stock : m.raw_stocks) {
+    Primitive p;
+    p.kind = PrimitiveKind::RawStock;
+    p.mode = Mode::Additive;
+    p.capability = stock.name;
+    p.cost_per_mm3 = 0;  // material is not costed; removing it is
+    if (stock.kind == config::RawStock::Kind::Box) {
+      p.label = "raw stock " + stock.name + " (box)";
+      add(p, [&] {
+        return geometry::make_box(lattice, {{bb.min.x - stock.margin[0], bb.min.y - stock.margin[1], bb.min.z - stock.margin[2]},
+                                            {bb.max.x + stock.margin[0], bb.max.y + stock.margin[1], bb.max.z + stock.margin[2]}});
+      });
+    } else {
+      p.label = "raw stock " + stock.name + " (round bar)";
+      add(p, [&] {
+        const geometry::Vec3 c{(bb.min.x + bb.max.x) / 2, (bb.min.y + bb.max.y) / 2, (bb.min.z + bb.max.z) / 2};
+        const geometry::Axis axis = stock.bar_axis == config::Axis::X   ? geometry::Axis::X
+                                    : stock.bar_axis == config::Axis::Y ? geometry::Axis::Y
+                                                                        : geometry::Axis::Z;
+        geometry::Vec3 base = c;
+        (axis == geometry::Axis::X ? base.x : axis == geometry::Axis::Y ? base.y : base.z) -= stock.bar_length / 2;
+        return geometry::make_cylinder(lattice, axis, base, stock.bar_diameter / 2, stock.bar_length);
+      });
+    }
+  }
+
+  for (const auto& head : m.heads)
+    for (const auto& setup : m.setups)
+      for (const auto kind : head.primitives) {
+        Primitive p;
+        p.mode = Mode::Additive;
+        p.capability = head.name;
+        p.setup = setup.name;
+        p.cost_per_mm3 = head.cost_per_mm3;
+        const Instrument in = bead_instrument(head, setup.approach);
+        if (kind == config::PrimitiveKind::UAm) {
+          p.kind = PrimitiveKind::UAm;
+          p.label = "U-AM " + head.name + " " + setup_words(setup);
+          add(p, [&] { return additive_maximal(design, in); });
+        } else if (kind == config::PrimitiveKind::OAm) {
+          p.kind = PrimitiveKind::OAm;
+          p.label = "O-AM " + head.name + " " + setup_words(setup);
+          add(p, [&] { return additive_conservative(design, in); });
+        }
+      }
+
+  for (const auto& tool : m.tools)
+    for (const auto& setup : m.setups)
+      for (const auto kind : tool.primitives) {
+        Primitive p;
+        p.mode = Mode::Subtractive;
+        p.capability = "T" + std::to_string(tool.number);
+        p.tool_number = tool.number;
+        p.setup = setup.name;
+        p.cost_per_mm3 = tool.cost_per_mm3;
+        const Instrument in = tool_instrument(tool, setup.approach);
+        const std::string tool_words = "T" + std::to_string(tool.number) + " (" + tool.name + ") " + setup_words(setup);
+        if (kind == config::PrimitiveKind::SmMax) {
+          p.kind = PrimitiveKind::SmMax;
+          p.label = "SM-max " + tool_words;
+          add(p, [&] { return subtractive_maximal(design, in, domain); });
+        } else if (kind == config::PrimitiveKind::SmCons) {
+          p.kind = PrimitiveKind::SmCons;
+          p.label = "SM-cons " + tool_words;
+          add(p, [&] { return subtractive_conservative(design, in, domain); });
+        }
+      }
+  if (progress) progress(out.size(), total, "done");
+  return out;
+}
+
+}  // namespace hybridctl::planner

@@ -1,0 +1,45 @@
+#pragma once
+// The primitives a machine offers for a design: for every additive head x setup its
+// U-AM and O-AM, for every cutting tool x setup its SM-max and SM-cons (as the machine
+// file allows), and the raw stocks. Primitives given as files join them.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "config/machine.hpp"
+#include "geometry/morphology.hpp"
+#include "geometry/solid.hpp"
+#include "planner/primitive_shapes.hpp"
+#include "planner/search.hpp"
+
+namespace hybridctl::planner {
+
+enum class PrimitiveKind { RawStock, UAm, OAm, SmMax, SmCons, File };
+const char* to_string(PrimitiveKind k);
+
+struct Primitive {
+  std::string name;          // P1, P2, ... in order
+  std::string label;         // for people: "U-AM DED-1 from +Z (top)"
+  PrimitiveKind kind = PrimitiveKind::File;
+  Mode mode = Mode::Additive;
+  std::string capability;    // head name, "T<n>", stock name or file path
+  std::string setup;         // setup name; empty for stocks and files
+  int tool_number = 0;       // for cutting tools
+  double cost_per_mm3 = 0;
+  geometry::Solid region;    // deposited (additive) or removed (subtractive) region
+};
+
+// The structuring elements of a head's bead and of a tool's cutting part and body, in
+// the part frame of a setup (the body extends from the tip towards the approach side).
+Instrument bead_instrument(const config::AdditiveHead& head, config::Approach approach);
+Instrument tool_instrument(const config::CuttingTool& tool, config::Approach approach);
+
+// Called with a message before each primitive is computed.
+using PrimitiveProgress = std::function<void(std::size_t done, std::size_t total, const std::string& what)>;
+
+// Stocks first, then heads, then tools, each over the machine's setups.
+std::vector<Primitive> machine_primitives(const config::Machine& machine, const geometry::Solid& design,
+                                          const geometry::IndexBox& domain, const PrimitiveProgress& progress = {});
+
+}  // namespace hybridctl::planner

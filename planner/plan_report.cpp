@@ -1,0 +1,238 @@
+#include "planner/plan_report.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "common/error.hpp"
+#include "geometry/vdb_file.hpp"
+
+namespace hybridctl::planner {
+namespace {
+
+using nlohmann::json;
+
+json vec(const geometry::Vec3& v) { return json::array({v.x, v.y, v.z}); }
+json ivec(const geometry::Index3& v) { return json::array({v.x, v.y, v.z}); }
+json box_json(const geometry::Box3& b) { return {{"min", vec(b.min)}, {"max", vec(b.max)}}; }
+
+const char* mode_name(Mode m) { return m == Mode::Additive ? "additive" : "subtractive"; }
+
+const char* modality_name(Modality m) {
+  switch (m) {
+    case Modality::AdditiveOnly: return "additive-only";
+    case Modality::SubtractiveOnly: return "subtractive-only";
+    case Modality::Hybrid: return "hybrid";
+  }
+  return "?";
+}
+
+json atom_ids(const AtomSet& set, int atoms) {
+  json ids = json::array();
+  for (int a = 0; a < atoms; ++a)
+    if (set.test(a)) ids.push_back(a);
+  return ids;
+}
+
+std::string fixed(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+}  // namespace
+
+std::string plan_json(const PlanningResult& r, const ReportSources& src) {
+  json doc;
+  doc["format"] = "hybridctl-plan";
+  doc["version"] = kPlanFormatVersion;
+  doc["part"] = src.part_path;
+  doc["machine"] = {{"name", src.machine_name}, {"file", src.machine_path}};
+  doc["grid"] = {{"voxel_size", r.lattice.voxel_size},
+                 {"origin", vec(r.lattice.origin)},
+                 {"domain", {{"lo", ivec(r.domain.lo)}, {"hi", ivec(r.domain.hi)}}}};
+  doc["design"] = {{"file", "design.vdb"},
+                   {"volume", r.design_volume},
+                   {"bounding_box", box_json(r.design.bounding_box_mm())}};
+  doc["tolerance"] = r.tolerance;
+  doc["sliver_threshold"] = r.sliver_threshold;
+  doc["cost_normaliser"] = r.problem.normaliser;
+  doc["fixed_costs"] = {{"tool_change", r.problem.fixed.tool_change},
+                        {"setup_change", r.problem.fixed.setup_change},
+                        {"mode_switch", r.problem.fixed.mode_switch}};
+  doc["max_uses"] = r.problem.max_uses;
+
+  json prims = json::array();
+  for (const Primitive& p : r.primitives) {
+    json j = {{"name", p.name},       {"label", p.label},       {"kind", to_string(p.kind)},
+              {"mode", mode_name(p.mode)}, {"capability", p.capability}, {"setup", p.setup},
+              {"cost_per_mm3", p.cost_per_mm3}, {"volume", p.region.volume()},
+              {"file", "primitives/" + p.name + ".vdb"}};
+    if (p.tool_number) j["tool_number"] = p.tool_number;
+    prims.push_back(j);
+  }
+  doc["primitives"] = prims;
+
+  const int n = int(r.primitives.size());
+  json atoms = json::array();
+  for (int a = 0; a < int(r.measures.size()); ++a) {
+    const AtomMeasures& m = r.measures[std::size_t(a)];
+    atoms.push_back({{"id", a},
+                     {"code", m.code.bits(n)},
+                     {"volume", m.volume},
+                     {"volume_in_design", m.volume_in_design},
+                     {"class", to_string(m.atom_class)},
+                     {"sliver", m.sliver},
+                     {"bounding_box", box_json(r.lattice.extent(m.bounding_box))},
+                     {"centroid", vec(m.centroid)}});
+  }
+  doc["atoms"] = atoms;
+
+  json violations = json::array();
+  for (const ViolatingAtom& v : r.verdict.violations) {
+    json in = json::array();
+    for (int i : v.primitives) in.push_back(r.primitives[std::size_t(i)].name);
+    violations.push_back({{"atom", v.atom},
+                          {"code", v.code},
+                          {"primitives", in},
+                          {"volume", v.volume},
+                          {"volume_in_design", v.volume_in_design},
+                          {"bounding_box", box_json(v.bounds)},
+                          {"centroid", vec(v.centroid)},
+                          {"description", v.description}});
+  }
+  doc["verdict"] = {{"manufacturable", r.verdict.manufacturable},
+                    {"decided_without_search", r.verdict.decided_without_search},
+                    {"modality", modality_name(r.verdict.modality)},
+                    {"summary", r.verdict.summary},
+                    {"violations", violations}};
+  doc["search"] = {{"expanded", r.search.expanded},
+                   {"generated", r.search.generated},
+                   {"exhausted", r.search.exhausted},
+                   {"limit_reached", r.search.limit_reached}};
+
+  json plans = json::array();
+  for (std::size_t k = 0; k < r.plans.size(); ++k) {
+    const Plan& plan = r.plans[k];
+    json actions = json::array();
+    for (std::size_t s = 0; s < plan.steps.size(); ++s) {
+      const PlanStep& step = plan.steps[s];
+      const Primitive& prim = r.primitives[std::size_t(step.primitive)];
+      actions.push_back({{"step", s + 1},
+                         {"primitive", prim.name},
+                         {"mode", mode_name(prim.mode)},
+                         {"volume", step.volume},
+                         {"cost", step.cost},
+                         {"region_atoms", atom_ids(step_region(r, plan, s), r.atoms.atom_count())}});
+    }
+    const Deviation& d = r.deviations[k];
+    plans.push_back({{"rank", k + 1},
+                     {"expression", expression(r.problem, plan)},
+                     {"cost", plan.cost},
+                     {"file", "plans/plan-" + std::to_string(k + 1) + ".vdb"},
+                     {"final_atoms", atom_ids(plan.final_state, r.atoms.atom_count())},
+                     {"deviation",
+                      {{"over_volume", d.over_volume},
+                       {"under_volume", d.under_volume},
+                       {"worst_distance", d.worst_distance},
+                       {"within_tolerance", d.within_tolerance}}},
+                     {"actions", actions}});
+  }
+  doc["plans"] = plans;
+  json timings = json::object();
+  for (const auto& [phase, seconds] : r.timings) timings[phase] = seconds;
+  doc["timings_s"] = timings;
+  return doc.dump(2) + "\n";
+}
+
+void write_plan_directory(const PlanningResult& r, const ReportSources& src, const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(dir, ec)) {
+    if (!fs::is_directory(dir, ec)) throw InputError(dir.string() + ": exists and is not a directory; expected a new or plan output directory");
+    if (!fs::is_empty(dir, ec) && !fs::exists(dir / "plan.json", ec)) {
+      throw InputError(dir.string() + ": not empty and holds no plan.json; refusing to replace it (expected a new, empty or earlier plan directory)");
+    }
+  }
+  const fs::path parent = dir.parent_path().empty() ? fs::path(".") : dir.parent_path();
+  if (!fs::is_directory(parent, ec)) throw InputError(dir.string() + ": cannot write: directory " + parent.string() + " does not exist");
+  // Everything goes into a fresh sibling directory that replaces DIR only when complete.
+  const fs::path staging = parent / ("." + dir.filename().string() + ".tmp-" + std::to_string(::getpid()));
+  fs::remove_all(staging, ec);
+  try {
+    fs::create_directories(staging / "primitives");
+    fs::create_directories(staging / "plans");
+    geometry::write_vdb(r.design, staging / "design.vdb", "design");
+    for (const Primitive& p : r.primitives) geometry::write_vdb(p.region, staging / "primitives" / (p.name + ".vdb"), p.name);
+    for (std::size_t k = 0; k < r.plans.size(); ++k)
+      geometry::write_vdb(plan_outcome(r, r.plans[k]), staging / "plans" / ("plan-" + std::to_string(k + 1) + ".vdb"),
+                          "plan-" + std::to_string(k + 1));
+    std::ofstream out(staging / "plan.json");
+    out << plan_json(r, src);
+    if (!out.flush()) throw InputError((staging / "plan.json").string() + ": cannot write");
+    out.close();
+    const fs::path old = parent / ("." + dir.filename().string() + ".old-" + std::to_string(::getpid()));
+    if (fs::exists(dir)) fs::rename(dir, old);
+    fs::rename(staging, dir);
+    fs::remove_all(old, ec);
+  } catch (const fs::filesystem_error& e) {
+    fs::remove_all(staging, ec);
+    throw InputError(dir.string() + ": cannot write: " + e.code().message());
+  } catch (...) {
+    fs::remove_all(staging, ec);
+    throw;
+  }
+}
+
+std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
+  std::ostringstream os;
+  const geometry::IndexBox b = r.design.bounding_box();
+  os << "design      " << src.part_path << ": " << fixed(r.design_volume, 1) << " mm\u00B3, " << (b.hi.x - b.lo.x) << " x "
+     << (b.hi.y - b.lo.y) << " x " << (b.hi.z - b.lo.z) << " voxels of " << r.lattice.voxel_size << " mm\n";
+  os << "machine     " << src.machine_name << " (" << src.machine_path << "), tolerance " << r.tolerance << " mm\n";
+  os << "primitives  " << r.primitives.size() << "\n";
+  for (const Primitive& p : r.primitives) {
+    char line[256];
+    std::snprintf(line, sizeof line, "  %-4s %-58s %-11s %12.1f mm\u00B3\n", p.name.c_str(), p.label.c_str(),
+                  p.mode == Mode::Additive ? "additive" : "subtractive", p.region.volume());
+    os << line;
+  }
+  int counts[4] = {0, 0, 0, 0}, slivers = 0;
+  for (const AtomMeasures& m : r.measures) {
+    ++counts[int(m.atom_class)];
+    slivers += m.sliver;
+  }
+  os << "atoms       " << r.measures.size() << ": " << counts[int(AtomClass::MustIn)] << " must-in, "
+     << counts[int(AtomClass::MustOut)] << " must-out, " << counts[int(AtomClass::Free)] << " free (" << slivers
+     << " slivers), " << counts[int(AtomClass::Violating)] << " violating\n";
+  os << "verdict     " << (r.verdict.manufacturable ? "manufacturable" : "NOT manufacturable") << ": " << r.verdict.summary
+     << "\n";
+  const std::size_t shown = std::min<std::size_t>(r.verdict.violations.size(), 10);
+  for (std::size_t i = 0; i < shown; ++i) os << "  - " << r.verdict.violations[i].description << "\n";
+  if (r.verdict.violations.size() > shown) os << "  ... and " << r.verdict.violations.size() - shown << " more in plan.json\n";
+  if (!r.plans.empty()) {
+    os << "plans       " << r.plans.size() << " (A*: " << r.search.expanded << " states expanded)\n";
+    for (std::size_t k = 0; k < r.plans.size(); ++k) {
+      const Plan& plan = r.plans[k];
+      const Deviation& d = r.deviations[k];
+      os << "  " << (k + 1) << ". " << expression(r.problem, plan) << "  cost " << fixed(plan.cost, 4) << "\n";
+      os << "     deviation: " << fixed(d.over_volume, 1) << " mm\u00B3 over, " << fixed(d.under_volume, 1)
+         << " mm\u00B3 under, worst " << fixed(d.worst_distance, 2) << " mm ("
+         << (d.within_tolerance ? "within" : "OUTSIDE") << " tolerance)\n";
+      for (std::size_t s = 0; s < plan.steps.size(); ++s) {
+        const PlanStep& st = plan.steps[s];
+        const Primitive& p = r.primitives[std::size_t(st.primitive)];
+        char line[256];
+        std::snprintf(line, sizeof line, "     %zu) %-4s %-58s %s %10.1f mm\u00B3  cost %.4f\n", s + 1, p.name.c_str(),
+                      p.label.c_str(), p.mode == Mode::Additive ? "deposit" : "remove ", st.volume, st.cost);
+        os << line;
+      }
+    }
+  }
+  return os.str();
+}
+
+}  // namespace hybridctl::planner

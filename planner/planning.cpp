@@ -1,0 +1,218 @@
+#include "planner/planning.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+
+#include "common/error.hpp"
+#include "geometry/vdb_file.hpp"
+#include "geometry/voxelize.hpp"
+
+namespace hybridctl::planner {
+namespace {
+
+using geometry::Box3;
+using geometry::IndexBox;
+using geometry::Lattice;
+using geometry::Solid;
+
+class PhaseClock {
+ public:
+  explicit PhaseClock(std::vector<std::pair<std::string, double>>& out) : out_(out) {}
+  void lap(const std::string& phase) {
+    const auto now = std::chrono::steady_clock::now();
+    out_.emplace_back(phase, std::chrono::duration<double>(now - last_).count());
+    last_ = now;
+  }
+
+ private:
+  std::vector<std::pair<std::string, double>>& out_;
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+Box3 grown(const Box3& b, double by) {
+  return {{b.min.x - by, b.min.y - by, b.min.z - by}, {b.max.x + by, b.max.y + by, b.max.z + by}};
+}
+
+Box3 box_hull(const Box3& a, const Box3& b) {
+  return {{std::min(a.min.x, b.min.x), std::min(a.min.y, b.min.y), std::min(a.min.z, b.min.z)},
+          {std::max(a.max.x, b.max.x), std::max(a.max.y, b.max.y), std::max(a.max.z, b.max.z)}};
+}
+
+// The region planning looks at: the design with room for overfill and the tolerance
+// band, and every raw stock.
+Box3 planning_region(const config::Machine& m, const Box3& design, double tolerance) {
+  double reach = tolerance;
+  for (const auto& head : m.heads) reach = std::max(reach, std::max(head.bead.width, head.bead.height));
+  Box3 region = grown(design, reach);
+  const geometry::Vec3 c{(design.min.x + design.max.x) / 2, (design.min.y + design.max.y) / 2,
+                         (design.min.z + design.max.z) / 2};
+  for (const auto& s : m.raw_stocks) {
+    if (s.kind == config::RawStock::Kind::Box) {
+      region = box_hull(region, {{design.min.x - s.margin[0], design.min.y - s.margin[1], design.min.z - s.margin[2]},
+                                 {design.max.x + s.margin[0], design.max.y + s.margin[1], design.max.z + s.margin[2]}});
+    } else {
+      const double r = s.bar_diameter / 2, l = s.bar_length / 2;
+      const geometry::Vec3 half{s.bar_axis == config::Axis::X ? l : r, s.bar_axis == config::Axis::Y ? l : r,
+                                s.bar_axis == config::Axis::Z ? l : r};
+      region = box_hull(region, {{c.x - half.x, c.y - half.y, c.z - half.z}, {c.x + half.x, c.y + half.y, c.z + half.z}});
+    }
+  }
+  return region;
+}
+
+Solid load_primitive_file(const PrimitiveFile& f, const Lattice& lattice) {
+  const std::string ext = std::filesystem::path(f.path).extension().string();
+  if (ext == ".stl" || ext == ".STL") return geometry::voxelize(geometry::read_stl(f.path), lattice, f.path);
+  if (ext == ".vdb") {
+    Solid s = geometry::read_vdb(f.path);
+    const double h = lattice.voxel_size;
+    const auto& o = s.lattice().origin;
+    if (std::abs(s.voxel_size() - h) > 1e-9 * h || std::abs(o.x) > 1e-6 * h || std::abs(o.y) > 1e-6 * h ||
+        std::abs(o.z) > 1e-6 * h) {
+      throw InputError(f.path + ": voxel size " + std::to_string(s.voxel_size()) + " mm, lattice origin (" +
+                       std::to_string(o.x) + ", " + std::to_string(o.y) + ", " + std::to_string(o.z) +
+                       "); expected voxel size " + std::to_string(h) + " mm with the origin at (0, 0, 0), as "
+                       "`hybridctl voxelize --voxel " + std::to_string(h) + "` writes");
+    }
+    Solid on_lattice(lattice, s.bounding_box());
+    s.for_each_voxel([&](geometry::Index3 v) { on_lattice.set(v); });
+    return on_lattice;
+  }
+  throw InputError(f.path + ": unknown primitive file type '" + ext + "', expected .stl or .vdb");
+}
+
+}  // namespace
+
+PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& part_name,
+                         const config::Machine& machine, const PlanningOptions& options) {
+  PlanningResult r;
+  PhaseClock clock(r.timings);
+  auto progress = [&](const std::string& phase, double f) {
+    if (options.progress) options.progress(phase, f);
+  };
+  const config::Planning& defaults = machine.planning;
+  const double h = options.voxel_size > 0 ? options.voxel_size : defaults.voxel_size;
+  r.tolerance = options.tolerance >= 0 ? options.tolerance : defaults.tolerance;
+  r.sliver_threshold = options.sliver_threshold >= 0 ? options.sliver_threshold : defaults.sliver_threshold;
+  const int top_k = options.top_k > 0 ? options.top_k : defaults.top_k;
+
+  r.lattice = {h, {0, 0, 0}};
+  r.design = geometry::voxelize(part, r.lattice, part_name, geometry::VoxelizeMethod::ExactScan,
+                                [&](double f) { progress("voxelize", f); });
+  if (r.design.empty()) throw InputError(part_name + ": no voxel centre lies inside the part at " + std::to_string(h) +
+                                         " mm; expected a smaller --voxel");
+  r.design_volume = r.design.volume();
+  const Box3 bb = r.design.bounding_box_mm();
+  r.bounding_box_volume = (bb.max.x - bb.min.x) * (bb.max.y - bb.min.y) * (bb.max.z - bb.min.z);
+  const IndexBox region = r.lattice.centers_within(planning_region(machine, bb, r.tolerance));
+  r.domain = {{region.lo.x - 2, region.lo.y - 2, region.lo.z - 2}, {region.hi.x + 2, region.hi.y + 2, region.hi.z + 2}};
+  r.design = intersect(r.design, Solid::filled(r.lattice, r.domain));
+  clock.lap("voxelize");
+
+  r.primitives = machine_primitives(machine, r.design, r.domain, [&](std::size_t done, std::size_t total, const std::string&) {
+    progress("primitives", total ? double(done) / double(total) : 1.0);
+  });
+  for (const PrimitiveFile& f : options.extra_primitives) {
+    Primitive p;
+    p.kind = PrimitiveKind::File;
+    p.mode = f.mode;
+    p.capability = f.path;
+    p.cost_per_mm3 = f.cost_per_mm3;
+    p.label = std::string(f.mode == Mode::Additive ? "additive" : "subtractive") + " primitive from " + f.path;
+    p.region = load_primitive_file(f, r.lattice);
+    p.name = "P" + std::to_string(r.primitives.size() + 1);
+    r.primitives.push_back(std::move(p));
+  }
+  if (r.primitives.empty()) throw InputError("the machine offers no primitives: expected heads, tools or stocks");
+  clock.lap("primitives");
+
+  r.atoms = AtomDecomposition(r.lattice, r.domain);
+  for (std::size_t i = 0; i < r.primitives.size(); ++i) {
+    r.atoms.add_primitive(r.primitives[i].region);
+    progress("atoms", double(i + 1) / double(r.primitives.size()));
+  }
+  r.measures = measure_atoms(r.atoms, r.design, make_tolerance_zone(r.design, r.tolerance), r.sliver_threshold);
+  clock.lap("atoms");
+
+  PlanningProblem& p = r.problem;
+  p.normaliser = r.bounding_box_volume > 0 ? r.bounding_box_volume : 1.0;
+  p.max_uses = options.max_uses;
+  p.fixed = {defaults.tool_change_cost, defaults.setup_change_cost, defaults.mode_switch_cost};
+  for (const AtomMeasures& m : r.measures) {
+    AtomSpec a;
+    a.volume = m.volume;
+    a.must_in = m.atom_class == AtomClass::MustIn || m.atom_class == AtomClass::Violating;
+    a.must_out = m.atom_class == AtomClass::MustOut || m.atom_class == AtomClass::Violating;
+    p.atoms.push_back(a);
+  }
+  for (std::size_t i = 0; i < r.primitives.size(); ++i) {
+    const Primitive& prim = r.primitives[i];
+    PrimitiveSpec s;
+    s.name = prim.name;
+    s.mode = prim.mode;
+    s.raw_stock = prim.kind == PrimitiveKind::RawStock;
+    s.cost_per_mm3 = prim.cost_per_mm3;
+    s.tool = prim.capability;
+    s.setup = prim.setup;
+    s.atoms = AtomSet(r.atoms.atom_count());
+    for (int a = 0; a < r.atoms.atom_count(); ++a)
+      if (r.atoms.code(a).test(int(i))) s.atoms.set(a);
+    p.primitives.push_back(std::move(s));
+  }
+  r.verdict = check_manufacturability(p, r.measures, r.lattice);
+  clock.lap("check");
+
+  if (r.verdict.manufacturable) {
+    progress("search", 0);
+    r.plans = find_plans(p, {top_k, options.max_expansions}, &r.search);
+    progress("search", 1);
+    if (r.plans.empty() && !r.verdict.decided_without_search) {
+      r.verdict.manufacturable = false;
+      r.verdict.summary = r.search.limit_reached ? "undecided: the search stopped at its expansion limit before a plan"
+                                                 : "not manufacturable: no sequence of these primitives makes the design";
+    }
+  }
+  clock.lap("search");
+
+  const Solid air = complement(r.design, r.domain);
+  for (const Plan& plan : r.plans) {
+    const Solid outcome = plan_outcome(r, plan);
+    const Solid over = subtract(outcome, r.design), under = subtract(r.design, outcome);
+    Deviation d;
+    d.over_volume = over.volume();
+    d.under_volume = under.volume();
+    // Centre-to-centre distances less half a voxel: the distance to the surface between.
+    const double worst = std::max(geometry::farthest_distance(over, r.design), geometry::farthest_distance(under, air));
+    d.worst_distance = std::max(0.0, worst - (over.empty() && under.empty() ? 0.0 : h / 2));
+    d.within_tolerance = d.worst_distance <= r.tolerance + 1e-9;
+    r.deviations.push_back(d);
+  }
+  clock.lap("deviation");
+  return r;
+}
+
+Solid plan_outcome(const PlanningResult& r, const Plan& plan) {
+  std::vector<bool> selected(static_cast<std::size_t>(r.atoms.atom_count()));
+  for (int a = 0; a < r.atoms.atom_count(); ++a) selected[std::size_t(a)] = plan.final_state.test(a);
+  return r.atoms.union_of(selected);
+}
+
+AtomSet step_region(const PlanningResult& r, const Plan& plan, std::size_t step) {
+  // Replay the plan on atom sets up to `step`.
+  AtomSet state(r.atoms.atom_count());
+  AtomSet roi(r.atoms.atom_count());
+  for (std::size_t s = 0; s <= step && s < plan.steps.size(); ++s) {
+    const PrimitiveSpec& prim = r.problem.primitives[std::size_t(plan.steps[s].primitive)];
+    for (std::size_t w = 0; w < state.words().size(); ++w) {
+      const std::uint64_t changed = prim.mode == Mode::Additive ? prim.atoms.words()[w] & ~state.words()[w]
+                                                                : prim.atoms.words()[w] & state.words()[w];
+      if (s == step) roi.words()[w] = changed;
+      state.words()[w] = prim.mode == Mode::Additive ? state.words()[w] | prim.atoms.words()[w]
+                                                     : state.words()[w] & ~prim.atoms.words()[w];
+    }
+  }
+  return roi;
+}
+
+}  // namespace hybridctl::planner

@@ -1,0 +1,75 @@
+#pragma once
+// One planning job from end to end: voxelize the design, compute the machine's
+// primitives (and any given as files), decompose into atoms, check, search.
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "config/machine.hpp"
+#include "geometry/mesh.hpp"
+#include "planner/atoms.hpp"
+#include "planner/check.hpp"
+#include "planner/machine_primitives.hpp"
+#include "planner/search.hpp"
+
+namespace hybridctl::planner {
+
+// A primitive given as a file (STL or .vdb) with its mode.
+struct PrimitiveFile {
+  std::string path;
+  Mode mode = Mode::Additive;
+  double cost_per_mm3 = 1.0;
+};
+
+struct PlanningOptions {
+  // Unset values (<= 0, or top_k 0) take the machine file's planning defaults.
+  double voxel_size = 0;
+  double tolerance = -1;
+  double sliver_threshold = -1;
+  int top_k = 0;
+  int max_uses = 1;
+  std::int64_t max_expansions = 5'000'000;
+  std::vector<PrimitiveFile> extra_primitives;
+  // Progress: a phase name and a fraction of it done.
+  std::function<void(const std::string& phase, double fraction)> progress;
+};
+
+// How far a plan's outcome is from the design.
+struct Deviation {
+  double over_volume = 0;    // mm^3 of material outside the design
+  double under_volume = 0;   // mm^3 of the design left empty
+  double worst_distance = 0; // mm: the farthest such voxel from the design's surface
+  bool within_tolerance = false;
+};
+
+struct PlanningResult {
+  geometry::Lattice lattice;
+  geometry::IndexBox domain;
+  geometry::Solid design;
+  double design_volume = 0;        // mm^3
+  double bounding_box_volume = 0;  // mm^3: the cost normaliser
+  double tolerance = 0;
+  double sliver_threshold = 0;
+  std::vector<Primitive> primitives;
+  AtomDecomposition atoms{geometry::Lattice{}, geometry::IndexBox{{0, 0, 0}, {1, 1, 1}}};
+  std::vector<AtomMeasures> measures;
+  PlanningProblem problem;
+  Verdict verdict;
+  std::vector<Plan> plans;
+  std::vector<Deviation> deviations;  // one per plan
+  SearchStats search;
+  std::vector<std::pair<std::string, double>> timings;  // phase, seconds
+};
+
+// Throws hybridctl::InputError for bad inputs (open mesh, unreadable primitive file,
+// a .vdb primitive on another lattice).
+PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& part_name,
+                         const config::Machine& machine, const PlanningOptions& options);
+
+// The solid a plan leaves: the union of the atoms in its final state.
+geometry::Solid plan_outcome(const PlanningResult& result, const Plan& plan);
+// The atoms an action of a plan deposits or removes (its region of influence).
+AtomSet step_region(const PlanningResult& result, const Plan& plan, std::size_t step);
+
+}  // namespace hybridctl::planner
