@@ -123,7 +123,8 @@ std::string join(const std::vector<std::string_view>& words, std::string_view se
 
 namespace {
 
-/// "" or " (did you mean 'x'?)" for the closest word within edit distance 2.
+/// "" or " (did you mean 'x'?)" for the closest word within edit distance 2. A word that
+/// would have to be replaced entirely ("up" for "+X") is no suggestion.
 std::string suggestion(std::string_view word, const std::vector<std::string_view>& choices) {
   constexpr std::size_t kMaxSuggestionDistance = 2;
   std::string_view best;
@@ -131,7 +132,7 @@ std::string suggestion(std::string_view word, const std::vector<std::string_view
   if (word.size() > 64) return {};
   for (auto c : choices) {
     const std::size_t d = edit_distance(word, c);
-    if (d < best_distance) {
+    if (d < best_distance && d < c.size()) {
       best_distance = d;
       best = c;
     }
