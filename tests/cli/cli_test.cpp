@@ -69,7 +69,7 @@ const std::string kBracket = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/part
 
 TEST_F(Cli, EverySubcommandHasHelp) {
   for (auto args : std::vector<std::vector<std::string>>{
-           {"--help"}, {"machine", "--help"}, {"machine", "check", "--help"}, {"voxelize", "--help"}, {"inspect", "--help"}}) {
+           {"--help"}, {"machine", "--help"}, {"machine", "check", "--help"}, {"voxelize", "--help"}, {"inspect", "--help"}, {"plan", "--help"}}) {
     const Outcome r = run(args);
     EXPECT_EQ(r.exit_code, 0) << args[0];
     EXPECT_NE(r.out.find("Usage"), std::string::npos) << r.out;
@@ -163,6 +163,74 @@ TEST_F(Cli, MachineCheckAcceptsTheExamplesAndPointsAtEveryProblem) {
   const Outcome r = run({"machine", "check", bad.string()});
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_NE(r.err.find(bad.string() + ":6:1:"), std::string::npos) << r.err;
+}
+
+}  // namespace
+
+namespace {
+
+const std::string kMachine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/hybrid-3axis.yaml";
+
+TEST_F(Cli, PlansTheBracketAndWritesPlanJsonWithValidPlans) {
+  const Outcome r = run({"plan", kBracket, "--machine", kMachine, "--voxel", "1", "-o", (dir_ / "plan").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("verdict     manufacturable"), std::string::npos) << r.out;
+  const std::string json = slurp(dir_ / "plan" / "plan.json");
+  EXPECT_NE(json.find("\"format\": \"hybridctl-plan\""), std::string::npos);
+  EXPECT_NE(json.find("\"version\": 1"), std::string::npos);
+  // At least two plans, each within tolerance.
+  std::size_t plans = 0, within = 0;
+  for (std::size_t at = json.find("\"rank\":"); at != std::string::npos; at = json.find("\"rank\":", at + 1)) ++plans;
+  for (std::size_t at = json.find("\"within_tolerance\": true"); at != std::string::npos;
+       at = json.find("\"within_tolerance\": true", at + 1))
+    ++within;
+  EXPECT_GE(plans, 2u);
+  EXPECT_EQ(within, plans);
+  EXPECT_TRUE(fs::exists(dir_ / "plan" / "design.vdb"));
+  EXPECT_TRUE(fs::exists(dir_ / "plan" / "primitives" / "P1.vdb"));
+  EXPECT_TRUE(fs::exists(dir_ / "plan" / "plans" / "plan-1.vdb"));
+  // Planning again over the earlier output replaces it.
+  EXPECT_EQ(run({"plan", kBracket, "--machine", kMachine, "--voxel", "1", "--top", "2", "-o", (dir_ / "plan").string()}).exit_code, 0);
+}
+
+TEST_F(Cli, PlanRefusesToReplaceADirectoryThatIsNotAPlan) {
+  write("precious.txt", "keep me");
+  const Outcome r = run({"plan", kBracket, "--machine", kMachine, "--voxel", "1", "-o", dir_.string()});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_NE(r.err.find("refusing to replace"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(dir_ / "precious.txt"), "keep me");
+}
+
+TEST_F(Cli, APartTheMachineCannotMakeExitsWithFour) {
+  // Only a cutting tool and no stock: nothing can put material down first.
+  const fs::path machine = write("mill-only.yaml",
+                                 "name: mill-only\n"
+                                 "envelope:\n"
+                                 "  X: {travel: [0, 300]}\n  Y: {travel: [0, 300]}\n  Z: {travel: [0, 300]}\n"
+                                 "tools:\n  - {number: 1, type: flat, diameter: 6}\n"
+                                 "setups:\n  - {name: top, approach: +Z}\n"
+                                 "raw_stocks: []\n");
+  const Outcome r = run({"plan", kBracket, "--machine", machine.string(), "--voxel", "2"});
+  EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
+  EXPECT_NE(r.out.find("NOT manufacturable"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, PlanArgumentsAreChecked) {
+  EXPECT_EQ(run({"plan", kBracket}).exit_code, 2);  // --machine missing
+  const Outcome bad = run({"plan", kBracket, "--machine", kMachine, "--primitive", "x.stl:maybe"});
+  EXPECT_EQ(bad.exit_code, 3);
+  EXPECT_NE(bad.err.find("expected FILE:am or FILE:sm"), std::string::npos) << bad.err;
+  const Outcome missing = run({"plan", kBracket, "--machine", kMachine, "--voxel", "2", "--primitive", "/nonexistent.stl:am"});
+  EXPECT_EQ(missing.exit_code, 3);
+  EXPECT_NE(missing.err.find("/nonexistent.stl"), std::string::npos) << missing.err;
+}
+
+TEST_F(Cli, PrimitivesMayComeFromFiles) {
+  // The part itself as an additive primitive: one deposition makes it exactly.
+  const Outcome r = run({"plan", kBracket, "--machine", kMachine, "--voxel", "2", "--primitive", kBracket + ":am", "-o",
+                         (dir_ / "p").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("additive primitive from " + kBracket), std::string::npos) << r.out;
 }
 
 }  // namespace
