@@ -313,22 +313,60 @@ void axial_dilate(const DenseGrid<std::uint8_t>& mask, DenseGrid<std::uint8_t>& 
                   std::int64_t hi) {
   const int n = mask.size(axis);
   const std::size_t stride = mask.stride(axis);
-  mask.for_each_line(axis, [&](std::size_t first) {
-    // Walk in the direction of the offsets so that sources come before their images.
-    std::int64_t last_source = std::numeric_limits<std::int64_t>::min() / 2;  // in walk steps
+  // Walk each line in the direction of the offsets, so sources come before their
+  // images, remembering where the last source was: p is reached when a source lies at
+  // a walk distance in [lo, hi] behind it. Lines are walked side by side, a whole
+  // slice across the axis at a time, so memory is read in order.
+  auto walk = [&](std::size_t base, std::size_t count, std::size_t element_stride) {
+    thread_local std::vector<std::int64_t> last;
+    last.assign(count, std::numeric_limits<std::int64_t>::min() / 2);
     for (int step = 0; step < n; ++step) {
-      // The source that can reach this step at the smallest offset `lo` is step - lo.
       const int src = step - lo;
-      if (src >= 0 && src < n) {
-        const int src_index = sign > 0 ? src : n - 1 - src;
-        if (mask.values[first + std::size_t(src_index) * stride]) last_source = src;
-      }
-      if (step - last_source <= hi) {
-        const int p = sign > 0 ? step : n - 1 - step;
-        out.values[first + std::size_t(p) * stride] = 1;
+      const int p = sign > 0 ? step : n - 1 - step;
+      const std::uint8_t* source = nullptr;
+      if (src >= 0 && src < n) source = mask.values.data() + base + std::size_t(sign > 0 ? src : n - 1 - src) * stride;
+      std::uint8_t* target = out.values.data() + base + std::size_t(p) * stride;
+      for (std::size_t i = 0; i < count; ++i) {
+        if (source && source[i * element_stride]) last[i] = src;
+        if (step - last[i] <= hi) target[i * element_stride] = 1;
       }
     }
+  };
+  if (axis == Axis::X) {
+    mask.for_each_line(axis, [&](std::size_t first) { walk(first, 1, 1); });
+  } else if (axis == Axis::Y) {
+    // One z slice at a time: rows of x are contiguous.
+    tbb::parallel_for(tbb::blocked_range<int>(0, mask.nz), [&](const tbb::blocked_range<int>& r) {
+      for (int z = r.begin(); z != r.end(); ++z) walk(mask.index(0, 0, z), std::size_t(mask.nx), 1);
+    });
+  } else {
+    // Slices across Z are whole xy planes; split them into strips of rows.
+    const int rows_per_strip = 8;
+    tbb::parallel_for(tbb::blocked_range<int>(0, (mask.ny + rows_per_strip - 1) / rows_per_strip),
+                      [&](const tbb::blocked_range<int>& r) {
+                        for (int strip = r.begin(); strip != r.end(); ++strip) {
+                          const int y0 = strip * rows_per_strip, y1 = std::min(mask.ny, y0 + rows_per_strip);
+                          walk(mask.index(0, y0, 0), std::size_t(y1 - y0) * std::size_t(mask.nx), 1);
+                        }
+                      });
+  }
+}
+
+// Copies the set bytes of a dense grid inside `domain` into a solid, a word at a time.
+Solid solid_from_bytes(const DenseGrid<std::uint8_t>& g, const Lattice& lattice, const IndexBox& domain) {
+  Solid out(lattice, domain);
+  const IndexBox b = box_intersection(domain, g.box);
+  if (b.empty()) return out;
+  tbb::parallel_for(tbb::blocked_range<int>(b.lo.z, b.hi.z), [&](const tbb::blocked_range<int>& r) {
+    for (int z = r.begin(); z != r.end(); ++z)
+      for (int y = b.lo.y; y < b.hi.y; ++y) {
+        auto row = out.row(y, z);
+        const std::uint8_t* line = g.values.data() + g.index(0, y - g.box.lo.y, z - g.box.lo.z) - g.box.lo.x;
+        for (int x = b.lo.x; x < b.hi.x; ++x)
+          if (line[x]) row[std::size_t((x >> 6) - out.first_word())] |= std::uint64_t{1} << (x & 63);
+      }
   });
+  return out;
 }
 
 Solid dilate_axial(const Solid& solid, const AxialBody& body, const IndexBox& work, const IndexBox& domain) {
@@ -370,13 +408,7 @@ Solid dilate_axial(const Solid& solid, const AxialBody& body, const IndexBox& wo
                       });
     for (const auto& [lo, hi] : intervals) axial_dilate(mask, result, a, body.direction.sign, lo, hi);
   }
-  Solid out(solid.lattice(), domain);
-  const IndexBox b = box_intersection(domain, work);
-  for (int z = b.lo.z; z < b.hi.z; ++z)
-    for (int y = b.lo.y; y < b.hi.y; ++y)
-      for (int x = b.lo.x; x < b.hi.x; ++x)
-        if (result.values[result.index(x - work.lo.x, y - work.lo.y, z - work.lo.z)]) out.set({x, y, z});
-  return out;
+  return solid_from_bytes(result, solid.lattice(), domain);
 }
 
 Solid dilate_brute_force(const Solid& solid, const std::vector<Index3>& offsets, const IndexBox& domain) {
