@@ -251,7 +251,10 @@ void distance_pass(DenseGrid<double>& g, Axis axis, double w, double limit, bool
   });
 }
 
-Solid threshold_into(const DenseGrid<double>& g, double limit, const Lattice& lattice, const IndexBox& domain) {
+// The voxels of `domain` whose grid value satisfies `keep`, copied into a solid a word
+// at a time.
+template <typename T, typename Keep>
+Solid solid_where(const DenseGrid<T>& g, Keep keep, const Lattice& lattice, const IndexBox& domain) {
   Solid out(lattice, domain);
   const IndexBox b = box_intersection(domain, g.box);
   if (b.empty()) return out;
@@ -259,14 +262,16 @@ Solid threshold_into(const DenseGrid<double>& g, double limit, const Lattice& la
     for (int z = r.begin(); z != r.end(); ++z)
       for (int y = b.lo.y; y < b.hi.y; ++y) {
         auto row = out.row(y, z);
+        const T* line = g.values.data() + g.index(0, y - g.box.lo.y, z - g.box.lo.z) - g.box.lo.x;
         for (int x = b.lo.x; x < b.hi.x; ++x)
-          if (g.values[g.index(x - g.box.lo.x, y - g.box.lo.y, z - g.box.lo.z)] <= limit) {
-            const int word = (x >> 6) - out.first_word();
-            row[std::size_t(word)] |= std::uint64_t{1} << (x & 63);
-          }
+          if (keep(line[x])) row[std::size_t((x >> 6) - out.first_word())] |= std::uint64_t{1} << (x & 63);
       }
   });
   return out;
+}
+
+Solid threshold_into(const DenseGrid<double>& g, double limit, const Lattice& lattice, const IndexBox& domain) {
+  return solid_where(g, [limit](double v) { return v <= limit; }, lattice, domain);
 }
 
 // The radius squared (in voxels^2) of an axial body at each level t along its axis.
@@ -352,21 +357,8 @@ void axial_dilate(const DenseGrid<std::uint8_t>& mask, DenseGrid<std::uint8_t>& 
   }
 }
 
-// Copies the set bytes of a dense grid inside `domain` into a solid, a word at a time.
 Solid solid_from_bytes(const DenseGrid<std::uint8_t>& g, const Lattice& lattice, const IndexBox& domain) {
-  Solid out(lattice, domain);
-  const IndexBox b = box_intersection(domain, g.box);
-  if (b.empty()) return out;
-  tbb::parallel_for(tbb::blocked_range<int>(b.lo.z, b.hi.z), [&](const tbb::blocked_range<int>& r) {
-    for (int z = r.begin(); z != r.end(); ++z)
-      for (int y = b.lo.y; y < b.hi.y; ++y) {
-        auto row = out.row(y, z);
-        const std::uint8_t* line = g.values.data() + g.index(0, y - g.box.lo.y, z - g.box.lo.z) - g.box.lo.x;
-        for (int x = b.lo.x; x < b.hi.x; ++x)
-          if (line[x]) row[std::size_t((x >> 6) - out.first_word())] |= std::uint64_t{1} << (x & 63);
-      }
-  });
-  return out;
+  return solid_where(g, [](std::uint8_t v) { return v != 0; }, lattice, domain);
 }
 
 Solid dilate_axial(const Solid& solid, const AxialBody& body, const IndexBox& work, const IndexBox& domain) {
