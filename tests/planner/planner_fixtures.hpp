@@ -25,13 +25,16 @@ struct VoxelProblem {
   IndexBox domain;
   AtomDecomposition atoms;
   PlanningProblem problem;
+  std::vector<AtomMeasures> measures;
 };
 
 // Atoms of the primitives over `domain`, classified exactly against the design.
-inline VoxelProblem make_problem(std::vector<VoxelPrimitive> prims, const Solid& design, const IndexBox& domain) {
+// `tolerance_mm` widens the band around the design where atoms are free either way.
+inline VoxelProblem make_problem(std::vector<VoxelPrimitive> prims, const Solid& design, const IndexBox& domain,
+                                 double tolerance_mm = 0) {
   AtomDecomposition atoms(design.lattice(), domain);
   for (const auto& p : prims) atoms.add_primitive(p.region);
-  const auto measures = measure_atoms(atoms, design, make_tolerance_zone(design, 0), 0);
+  const auto measures = measure_atoms(atoms, design, make_tolerance_zone(design, tolerance_mm), 0);
   PlanningProblem problem;
   for (const auto& m : measures) {
     AtomSpec a;
@@ -51,7 +54,7 @@ inline VoxelProblem make_problem(std::vector<VoxelPrimitive> prims, const Solid&
       if (atoms.code(a).test(i)) s.atoms.set(a);
     problem.primitives.push_back(s);
   }
-  return {std::move(prims), design, domain, std::move(atoms), std::move(problem)};
+  return {std::move(prims), design, domain, std::move(atoms), std::move(problem), measures};
 }
 
 // The plan carried out on the voxels themselves.
