@@ -1,0 +1,3 @@
+# hybridctl_toolpaths: toolpaths from regions of influence.
+add_library(hybridctl_toolpaths INTERFACE)
+target_link_libraries(hybridctl_toolpaths INTERFACE hybridctl_geometry hybridctl_config hybridctl_common)
