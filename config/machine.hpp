@@ -95,6 +95,9 @@ struct AdditiveHead {
   double hatch_spacing = 0.0;           ///< mm, 0 < s <= bead.width; default 0.7 x bead.width
   double travel_clearance = 5.0;        ///< mm lifted for travel moves, >= 0
   double feed = 1000.0;                 ///< mm/min while depositing
+  /// The T number that selects the head (`T.. M6`); default 100 + its index in `heads`;
+  /// unique among heads and never a cutting tool's number.
+  int tool_number = 0;
   DepositionCodes codes;
   double cost_per_mm3 = 1.0;            ///< cost factor per mm³ deposited, >= 0
   std::vector<PrimitiveKind> primitives = {PrimitiveKind::UAm, PrimitiveKind::OAm};
@@ -105,6 +108,9 @@ struct AdditiveHead {
     return false;
   }
 };
+
+/// The default head tool number is this plus the head's index in the machine file.
+inline constexpr int kDefaultHeadToolNumberBase = 100;
 
 /// Fractions that derive a head's layer height and hatch spacing from its bead when the
 /// machine file does not give them.
@@ -161,6 +167,10 @@ struct Setup {
   std::string description;
   Approach approach = Approach::PlusZ;
   int work_offset = 54;                 ///< 54..59 for G54..G59
+  /// Machine coordinates (mm) of the setup's work zero: the G54..G59 offset. Program
+  /// (work-frame) coordinates + work_origin = machine coordinates, for rotary setups too.
+  /// Default: X and Y at the middle of their travel, Z at the bottom of the Z travel.
+  std::array<double, 3> work_origin = {0.0, 0.0, 0.0};
   bool manual_refixture = false;        ///< the operator re-clamps the part before this setup
   std::vector<RotaryPosition> rotary;   ///< axes not listed are not commanded
 
@@ -259,6 +269,19 @@ struct Machine {
   const AdditiveHead* find_head(std::string_view head_name) const {
     for (const auto& h : heads)
       if (h.name == head_name) return &h;
+    return nullptr;
+  }
+  /// The head selected by T number `number`, if any.
+  const AdditiveHead* find_head_by_tool(int number) const {
+    for (const auto& h : heads)
+      if (h.tool_number == number) return &h;
+    return nullptr;
+  }
+  /// The first setup using work offset G`offset` (54..59); setups sharing an offset share
+  /// its work_origin (the loader checks).
+  const Setup* find_setup_by_work_offset(int offset) const {
+    for (const auto& s : setups)
+      if (s.work_offset == offset) return &s;
     return nullptr;
   }
   const Setup* find_setup(std::string_view setup_name) const {

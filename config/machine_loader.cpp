@@ -85,6 +85,7 @@ class Loader {
     else if (heads && tools && *heads + *tools == 0)
       sink_.error((heads_field ? heads_field : tools_field)->value.mark,
                   "expected at least one additive head under 'heads' or cutting tool under 'tools', got none");
+    check_head_tool_numbers();
     if (auto f = r.require("setups")) read_setups(f->value);
     if (auto f = r.find("raw_stocks")) read_raw_stocks(f->value);
     if (auto f = r.find("planning")) read_planning(f->value);
@@ -212,7 +213,7 @@ class Loader {
   void read_head(const Value& v) {
     MapReader r(sink_, v,
                 {"name", "process", "bead", "nozzle", "layer_height", "hatch_spacing", "travel_clearance", "feed",
-                 "codes", "cost_per_mm3", "primitives"});
+                 "tool_number", "codes", "cost_per_mm3", "primitives"});
     if (!r.ok()) return;
     AdditiveHead h;
     if (auto f = r.require("name")) {
@@ -265,6 +266,16 @@ class Loader {
 
     number(r, "travel_clearance", kLength, Bound::NonNegative, h.travel_clearance);
     number(r, "feed", kFeed, Bound::Positive, h.feed);
+    // The T number: given, or 100 + the head's index; clashes are checked once tools are read.
+    h.tool_number = kDefaultHeadToolNumberBase + static_cast<int>(machine_.heads.size());
+    HeadToolNumber place{v.mark, v.path + ".tool_number", false};
+    if (auto f = r.find("tool_number")) {
+      place = {f->value.mark, f->value.path, true};
+      set(read_integer(sink_, f->value, 1, kMaxToolNumber,
+                       "a positive integer tool number (1.." + std::to_string(kMaxToolNumber) + ")"),
+          h.tool_number);
+    }
+    head_tool_numbers_.push_back(place);
     number(r, "cost_per_mm3", kCostFactor, Bound::NonNegative, h.cost_per_mm3);
     if (auto f = r.find("codes")) read_deposition_codes(f->value, h.codes);
     if (auto f = r.find("primitives")) h.primitives = primitives(f->value, kAdditivePrimitives, h.primitives);
@@ -294,6 +305,31 @@ class Loader {
       if (!power)
         sink_.error(power_value->value.mark,
                     power_value->value.path + ": has no effect without a 'power' template such as 'M68 E0 Q{power}'");
+    }
+  }
+
+  /// Head tool numbers are unique among heads and never a cutting tool's number.
+  void check_head_tool_numbers() {
+    std::map<int, std::size_t> first_head;
+    for (std::size_t i = 0; i < machine_.heads.size() && i < head_tool_numbers_.size(); ++i) {
+      const int number = machine_.heads[i].tool_number;
+      const HeadToolNumber& at = head_tool_numbers_[i];
+      const std::string what = at.given ? at.path + ": tool number " + std::to_string(number)
+                                        : at.path + ": the default tool number " + std::to_string(number) +
+                                              " (100 + the head's index)";
+      const std::string fix = at.given ? "expected a T number no cutting tool or other head uses"
+                                       : "set heads[" + std::to_string(i) +
+                                             "].tool_number to a T number no cutting tool or other head uses";
+      const auto tool = tool_numbers_.find(number);
+      if (tool != tool_numbers_.end()) {
+        sink_.error(at.mark, what + " is already the number of the cutting tool at line " + line_of(tool->second) +
+                                 "; " + fix);
+        continue;
+      }
+      const auto [it, inserted] = first_head.emplace(number, i);
+      if (!inserted)
+        sink_.error(at.mark, what + " is already the tool number of head '" +
+                                 printable(machine_.heads[it->second].name) + "'; " + fix);
     }
   }
 
@@ -435,19 +471,45 @@ class Loader {
   }
 
   void read_setup(const Value& v) {
-    MapReader r(sink_, v, {"name", "description", "approach", "work_offset", "manual_refixture", "rotary"});
+    MapReader r(sink_, v,
+                {"name", "description", "approach", "work_offset", "work_origin", "manual_refixture", "rotary"});
     if (!r.ok()) return;
     Setup s;
+    const Envelope& e = machine_.envelope;
+    s.work_origin = {0.5 * (e.x.travel.min + e.x.travel.max), 0.5 * (e.y.travel.min + e.y.travel.max),
+                     e.z.travel.min};
     if (auto f = r.require("name")) {
       set(read_string(sink_, f->value, "a setup name"), s.name);
       if (!s.name.empty()) unique(setup_names_, s.name, f->value, "setup name");
     }
     if (auto f = r.find("description")) set(read_string(sink_, f->value, "a description"), s.description);
     if (auto f = r.find("approach")) set(read_enum(sink_, f->value, kApproaches), s.approach);
-    if (auto f = r.find("work_offset")) set(read_enum(sink_, f->value, kWorkOffsets), s.work_offset);
+    const auto* offset_field = r.find("work_offset");
+    if (offset_field) set(read_enum(sink_, offset_field->value, kWorkOffsets), s.work_offset);
+    if (auto f = r.find("work_origin")) read_work_origin(f->value, s);
+    // Setups that share a work offset share its origin: G54 can only mean one place.
+    for (const auto& other : machine_.setups) {
+      if (other.work_offset != s.work_offset || other.work_origin == s.work_origin) continue;
+      const Value& at = offset_field ? offset_field->value : v;
+      sink_.error(at.mark, at.path + ": G" + std::to_string(s.work_offset) + " is already the work offset of setup '" +
+                               printable(other.name) + "' with another work_origin; expected a work offset of its "
+                               "own or the same work_origin");
+      break;
+    }
     if (auto f = r.find("manual_refixture")) set(read_bool(sink_, f->value), s.manual_refixture);
     if (auto f = r.find("rotary")) read_rotary_positions(f->value, s);
     machine_.setups.push_back(std::move(s));
+  }
+
+  void read_work_origin(const Value& v, Setup& s) {
+    constexpr std::string_view kExpected = "expected the machine coordinates of the work zero as [x, y, z] in mm";
+    if (!v.node.IsSequence() || v.node.size() != 3) {
+      const std::string got = v.node.IsSequence() ? "a list of " + std::to_string(v.node.size()) : describe(v.node);
+      sink_.error(v.mark, v.path + ": " + std::string(kExpected) + ", got " + got);
+      return;
+    }
+    const auto items = read_list(sink_, v, "coordinates");
+    for (std::size_t i = 0; i < 3; ++i) set(read_number(sink_, (*items)[i], kLength, Bound::Any), s.work_origin[i]);
   }
 
   void read_rotary_positions(const Value& v, Setup& s) {
@@ -636,6 +698,13 @@ class Loader {
   bool rotary_axes_known_ = false;
   std::map<std::string, YAML::Mark> head_names_, tool_names_, setup_names_, stock_names_;
   std::map<int, YAML::Mark> tool_numbers_;
+  /// Where each head's tool number was given (or the head, for the default), by head index.
+  struct HeadToolNumber {
+    YAML::Mark mark;
+    std::string path;
+    bool given = false;
+  };
+  std::vector<HeadToolNumber> head_tool_numbers_;
 };
 
 }  // namespace

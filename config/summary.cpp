@@ -55,10 +55,10 @@ std::string summarize(const Machine& m) {
 
   out.row("heads", std::to_string(m.heads.size()));
   for (const auto& h : m.heads) {
-    std::string text = std::string(to_string(h.process)) + ", bead " + std::string(to_string(h.bead.shape)) + " " +
-                       fmt(h.bead.width) + " x " + fmt(h.bead.height) + " mm, layer " + fmt(h.layer_height) +
-                       " mm, hatch " + fmt(h.hatch_spacing) + " mm, feed " + fmt(h.feed) + " mm/min, " +
-                       primitives(h.primitives);
+    std::string text = "T" + std::to_string(h.tool_number) + ", " + std::string(to_string(h.process)) + ", bead " +
+                       std::string(to_string(h.bead.shape)) + " " + fmt(h.bead.width) + " x " + fmt(h.bead.height) +
+                       " mm, layer " + fmt(h.layer_height) + " mm, hatch " + fmt(h.hatch_spacing) + " mm, feed " +
+                       fmt(h.feed) + " mm/min, " + primitives(h.primitives);
     if (h.nozzle) text += ", nozzle ø" + fmt(h.nozzle->diameter) + " x " + fmt(h.nozzle->length) + " mm";
     out.item(h.name, text);
   }
@@ -77,6 +77,7 @@ std::string summarize(const Machine& m) {
   for (const auto& s : m.setups) {
     std::string text = "approach " + std::string(to_string(s.approach)) + ", G" + std::to_string(s.work_offset);
     for (const auto& r : s.rotary) text += ", " + std::string(1, r.axis) + " " + fmt(r.degrees) + " deg";
+    text += ", work zero at X" + fmt(s.work_origin[0]) + " Y" + fmt(s.work_origin[1]) + " Z" + fmt(s.work_origin[2]);
     if (s.manual_refixture) text += ", manual refixture";
     out.item(s.name, text);
   }
