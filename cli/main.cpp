@@ -11,7 +11,7 @@ int main(int argc, char** argv) {
   CLI::App app{
       "hybridctl plans hybrid manufacturing (metal deposition and milling on one machine)\n"
       "from a part (STL) and a machine description (YAML).\n\n"
-      "Exit codes: 0 success, 1 internal error, 2 usage error, 3 bad input (file, YAML, STL),\n"
+      "Exit codes: 0 success, 1 internal error, 2 usage error, 3 bad input (file, YAML, STL, G-code),\n"
       "4 part not manufacturable with the machine's primitives (plan).",
       "hybridctl"};
   app.set_version_flag("--version", "hybridctl 0.1.0");
@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   add_voxelize_command(app, runner);
   add_inspect_command(app, runner);
   add_plan_command(app, runner);
+  add_gcode_command(app, runner);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

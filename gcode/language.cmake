@@ -1,4 +1,13 @@
-# hybridctl_gcode: the G-code language (parser, interpreter, post-processor, checks).
-add_library(hybridctl_gcode INTERFACE)
-target_include_directories(hybridctl_gcode INTERFACE ${PROJECT_SOURCE_DIR})
-target_link_libraries(hybridctl_gcode INTERFACE hybridctl_geometry hybridctl_config hybridctl_common)
+# hybridctl_gcode: the G-code language (parser, modal interpreter, checks and time
+# estimate, post-processor, LinuxCNC tool table). No OpenVDB: it uses geometry's plain
+# Vec3 header only.
+add_library(hybridctl_gcode STATIC
+  ${CMAKE_CURRENT_LIST_DIR}/parser.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/interpreter.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/check.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/files.cpp
+)
+target_include_directories(hybridctl_gcode PUBLIC ${PROJECT_SOURCE_DIR})
+target_link_libraries(hybridctl_gcode
+  PUBLIC hybridctl_geometry hybridctl_config hybridctl_common
+  PRIVATE hybridctl_warnings)

@@ -1,0 +1,352 @@
+#include "gcode/check.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace hybridctl::gcode {
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * M_PI;
+constexpr double kFullCircle = 1e-9;  ///< mm: start and end this close make a full circle
+
+std::string fmt(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4f", v);
+  std::string s = buf;
+  while (!s.empty() && s.back() == '0') s.pop_back();
+  if (!s.empty() && s.back() == '.') s.pop_back();
+  if (s == "-0") s = "0";
+  return s;
+}
+
+double get(const Vec3& v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
+double& get(Vec3& v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
+
+struct PlaneAxes {
+  int first, second, normal;
+};
+PlaneAxes plane_axes(Plane p) {
+  switch (p) {
+    case Plane::XY: return {0, 1, 2};
+    case Plane::ZX: return {2, 0, 1};
+    case Plane::YZ: return {1, 2, 0};
+  }
+  return {0, 1, 2};
+}
+
+const config::LinearAxis& linear(const config::Envelope& e, int axis) {
+  return axis == 0 ? e.x : axis == 1 ? e.y : e.z;
+}
+
+/// Time to travel distance `d` from rest to rest with cruise speed v and acceleration a.
+double trapezoid(double d, double v, double a) {
+  if (d <= 0 || v <= 0 || a <= 0) return 0;
+  if (d * a >= v * v) return d / v + v / a;
+  return 2.0 * std::sqrt(d / a);
+}
+
+void add(std::vector<Finding>& list, int& not_listed, std::size_t max, Finding f) {
+  if (list.size() < max)
+    list.push_back(std::move(f));
+  else
+    ++not_listed;
+}
+
+}  // namespace
+
+double arc_sweep(const Motion& m) {
+  const PlaneAxes pa = plane_axes(m.plane);
+  const double a0 = std::atan2(get(m.from_machine, pa.second) - get(m.centre_machine, pa.second),
+                               get(m.from_machine, pa.first) - get(m.centre_machine, pa.first));
+  const double a1 = std::atan2(get(m.to_machine, pa.second) - get(m.centre_machine, pa.second),
+                               get(m.to_machine, pa.first) - get(m.centre_machine, pa.first));
+  const double chord = std::hypot(get(m.to_machine, pa.first) - get(m.from_machine, pa.first),
+                                  get(m.to_machine, pa.second) - get(m.from_machine, pa.second));
+  if (chord < kFullCircle) return kTwoPi;
+  double sweep = m.kind == MotionKind::ArcCcw ? a1 - a0 : a0 - a1;
+  while (sweep <= 0) sweep += kTwoPi;
+  while (sweep > kTwoPi) sweep -= kTwoPi;
+  return sweep;
+}
+
+void motion_bounds(const Motion& m, Vec3& lo, Vec3& hi) {
+  lo = {std::min(m.from_machine.x, m.to_machine.x), std::min(m.from_machine.y, m.to_machine.y),
+        std::min(m.from_machine.z, m.to_machine.z)};
+  hi = {std::max(m.from_machine.x, m.to_machine.x), std::max(m.from_machine.y, m.to_machine.y),
+        std::max(m.from_machine.z, m.to_machine.z)};
+  if (!m.is_arc()) return;
+  const PlaneAxes pa = plane_axes(m.plane);
+  const double cx = get(m.centre_machine, pa.first), cy = get(m.centre_machine, pa.second);
+  const double r = std::hypot(get(m.from_machine, pa.first) - cx, get(m.from_machine, pa.second) - cy);
+  const double start = std::atan2(get(m.from_machine, pa.second) - cy, get(m.from_machine, pa.first) - cx);
+  const double sweep = arc_sweep(m);
+  const bool ccw = m.kind == MotionKind::ArcCcw;
+  // The circle's extreme points at 0, 90, 180 and 270 degrees, where the sweep covers them.
+  for (int k = 0; k < 4; ++k) {
+    const double angle = k * M_PI_2;
+    double delta = ccw ? angle - start : start - angle;
+    while (delta < 0) delta += kTwoPi;
+    while (delta >= kTwoPi) delta -= kTwoPi;
+    if (delta > sweep) continue;
+    const double x = cx + r * std::cos(angle), y = cy + r * std::sin(angle);
+    get(lo, pa.first) = std::min(get(lo, pa.first), x);
+    get(hi, pa.first) = std::max(get(hi, pa.first), x);
+    get(lo, pa.second) = std::min(get(lo, pa.second), y);
+    get(hi, pa.second) = std::max(get(hi, pa.second), y);
+  }
+}
+
+std::optional<std::string> envelope_violation(const Motion& m, const config::Envelope& envelope, double tolerance) {
+  Vec3 lo, hi;
+  motion_bounds(m, lo, hi);
+  std::string out;
+  const char names[3] = {'X', 'Y', 'Z'};
+  for (int axis = 0; axis < 3; ++axis) {
+    const config::Range& t = linear(envelope, axis).travel;
+    const std::string travel = std::string(1, names[axis]) + " travel [" + fmt(t.min) + ", " + fmt(t.max) + "]";
+    if (get(lo, axis) < t.min - tolerance)
+      out += std::string(out.empty() ? "" : "; ") + names[axis] + " reaches " + fmt(get(lo, axis)) +
+             ", below the " + travel;
+    if (get(hi, axis) > t.max + tolerance)
+      out += std::string(out.empty() ? "" : "; ") + names[axis] + " reaches " + fmt(get(hi, axis)) +
+             ", beyond the " + travel;
+  }
+  const std::pair<char, std::pair<double, double>> rotary[3] = {{'A', {m.from_rotary.a, m.to_rotary.a}},
+                                                                {'B', {m.from_rotary.b, m.to_rotary.b}},
+                                                                {'C', {m.from_rotary.c, m.to_rotary.c}}};
+  for (const auto& [name, positions] : rotary) {
+    const config::RotaryAxis* axis = envelope.find_rotary(name);
+    if (!axis) {
+      if (positions.first != positions.second)
+        out += std::string(out.empty() ? "" : "; ") + name + " moves to " + fmt(positions.second) +
+               " but the machine has no " + name + " axis";
+      continue;
+    }
+    for (double v : {positions.first, positions.second})
+      if (v < axis->range.min - tolerance || v > axis->range.max + tolerance) {
+        out += std::string(out.empty() ? "" : "; ") + name + " reaches " + fmt(v) + " deg, outside the " + name +
+               " range [" + fmt(axis->range.min) + ", " + fmt(axis->range.max) + "]";
+        break;
+      }
+  }
+  if (out.empty()) return std::nullopt;
+  return out;
+}
+
+double motion_time(const Motion& m, const config::Envelope& envelope) {
+  const config::RotaryAxis default_rotary;
+  const auto rotary_axis = [&](char name) -> const config::RotaryAxis& {
+    const config::RotaryAxis* a = envelope.find_rotary(name);
+    return a ? *a : default_rotary;
+  };
+  // The motion is parametrised by u in [0, 1]; each limit caps du/dt and d2u/dt2.
+  double u_speed = INFINITY, u_accel = INFINITY;
+  const auto limit = [&](double extent, double max_feed_per_min, double max_accel) {
+    if (extent <= 0) return;
+    u_speed = std::min(u_speed, max_feed_per_min / 60.0 / extent);
+    u_accel = std::min(u_accel, max_accel / extent);
+  };
+  const double rotary_delta[3] = {std::abs(m.to_rotary.a - m.from_rotary.a), std::abs(m.to_rotary.b - m.from_rotary.b),
+                                  std::abs(m.to_rotary.c - m.from_rotary.c)};
+  double rotary_length = 0;
+  for (int k = 0; k < 3; ++k) {
+    const config::RotaryAxis& axis = rotary_axis("ABC"[k]);
+    limit(rotary_delta[k], axis.max_feed, axis.max_acceleration);
+    rotary_length = std::max(rotary_length, rotary_delta[k]);
+  }
+  double length = 0;  // linear path length
+  if (m.is_arc()) {
+    const PlaneAxes pa = plane_axes(m.plane);
+    const double r = std::hypot(get(m.from_machine, pa.first) - get(m.centre_machine, pa.first),
+                                get(m.from_machine, pa.second) - get(m.centre_machine, pa.second));
+    const double arc = r * arc_sweep(m);
+    const double h = std::abs(get(m.to_machine, pa.normal) - get(m.from_machine, pa.normal));
+    length = std::hypot(arc, h);
+    const config::LinearAxis& a1 = linear(envelope, pa.first);
+    const config::LinearAxis& a2 = linear(envelope, pa.second);
+    const double plane_feed = std::min(a1.max_feed, a2.max_feed);
+    const double plane_accel = std::min(a1.max_acceleration, a2.max_acceleration);
+    limit(arc, plane_feed, plane_accel);
+    // Centripetal: v^2 / r <= a.
+    if (arc > 0) u_speed = std::min(u_speed, std::sqrt(plane_accel * r) / arc);
+    const config::LinearAxis& n = linear(envelope, pa.normal);
+    limit(h, n.max_feed, n.max_acceleration);
+  } else {
+    const double d[3] = {std::abs(m.to_machine.x - m.from_machine.x), std::abs(m.to_machine.y - m.from_machine.y),
+                         std::abs(m.to_machine.z - m.from_machine.z)};
+    length = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    for (int axis = 0; axis < 3; ++axis)
+      limit(d[axis], linear(envelope, axis).max_feed, linear(envelope, axis).max_acceleration);
+  }
+  if (m.kind != MotionKind::Rapid && m.feed > 0) {
+    // F is along the linear path; for rotary-only moves it is in deg/min.
+    const double extent = length > 0 ? length : rotary_length;
+    if (extent > 0) u_speed = std::min(u_speed, m.feed / 60.0 / extent);
+  }
+  if (!std::isfinite(u_speed) || !std::isfinite(u_accel)) return 0;  // no movement
+  return trapezoid(1.0, u_speed, u_accel);
+}
+
+std::string format_duration(double seconds) {
+  char buf[64];
+  if (seconds < 60) {
+    std::snprintf(buf, sizeof buf, "%.1f s", seconds);
+  } else if (seconds < 3600) {
+    const int minutes = static_cast<int>(seconds / 60);
+    std::snprintf(buf, sizeof buf, "%d min %04.1f s", minutes, seconds - 60.0 * minutes);
+  } else {
+    const long total = std::lround(seconds);
+    std::snprintf(buf, sizeof buf, "%ld h %02ld min %02ld s", total / 3600, (total / 60) % 60, total % 60);
+  }
+  return buf;
+}
+
+CheckReport check_program(std::string_view text, const config::Machine& machine, std::string file_name,
+                          const CheckOptions& options) {
+  CheckReport report;
+  report.file = file_name;
+  Interpreter interpreter(machine, file_name, options.interpreter);
+  const std::size_t max = options.max_listed;
+  int& more = report.errors_not_listed;
+  bool warned_spindle_stopped = false;  // one finding per run of feed moves with the spindle stopped
+
+  const auto tool_name = [&](int number) -> std::string {
+    if (const config::CuttingTool* t = machine.find_tool(number)) return "T" + std::to_string(number) + " (" + t->name + ")";
+    if (const config::AdditiveHead* h = machine.find_head_by_tool(number))
+      return "T" + std::to_string(number) + " (head " + h->name + ")";
+    return "T" + std::to_string(number);
+  };
+
+  for_each_line(text, [&](std::string_view line, int number) {
+    report.lines = number;
+    const LineResult* result = nullptr;
+    try {
+      result = &interpreter.execute_line(line, number);
+    } catch (const GcodeError& e) {
+      add(report.errors, more, max, Finding{e.line(), e.column(), e.message()});
+      return;
+    }
+    const ModalState& after = interpreter.state();
+    const bool head_active_after = machine.find_head_by_tool(after.tool) != nullptr;
+    for (const Event& e : result->events) {
+      switch (e.kind) {
+        case EventKind::ToolChange:
+          ++report.time.tool_changes;
+          if (e.tool != 0 && !machine.find_tool(e.tool) && !machine.find_head_by_tool(e.tool)) {
+            std::string known;
+            for (const auto& t : machine.tools) known += (known.empty() ? "" : ", ") + std::string("T") + std::to_string(t.number);
+            for (const auto& h : machine.heads)
+              known += (known.empty() ? "" : ", ") + std::string("T") + std::to_string(h.tool_number) + " (" + h.name + ")";
+            add(report.tools, more, max,
+                Finding{e.line, e.column, "T" + std::to_string(e.tool) + " is neither a cutting tool nor a head of machine '" +
+                                              machine.name + "'; expected one of " + known});
+          }
+          break;
+        case EventKind::DepositionOn:
+          if (!head_active_after)
+            add(report.process, more, max,
+                Finding{e.line, e.column,
+                        "deposition on for head '" + machine.heads[static_cast<std::size_t>(e.index)].name + "' while " +
+                            (after.tool == 0 ? std::string("no tool") : tool_name(after.tool)) +
+                            " is in the spindle; expected the head selected first (T" + std::to_string(e.tool) +
+                            " " + machine.gcode.m_codes.tool_change + ")"});
+          break;
+        case EventKind::SpindleStart:
+          if (head_active_after)
+            add(report.process, more, max,
+                Finding{e.line, e.column, "spindle started while " + tool_name(after.tool) +
+                                              " is active; expected a cutting tool in the spindle"});
+          break;
+        case EventKind::Dwell: report.time.dwell += e.value; break;
+        case EventKind::ProgramStop:
+        case EventKind::OptionalStop: ++report.time.program_stops; break;
+        case EventKind::ProgramEnd: report.program_end = true; break;
+        default: break;
+      }
+    }
+    for (const Motion& m : result->motions) {
+      ++report.motions;
+      if (m.kind == MotionKind::Rapid)
+        ++report.rapids;
+      else if (m.kind == MotionKind::Feed)
+        ++report.feeds;
+      else
+        ++report.arcs;
+      if (auto v = envelope_violation(m, machine.envelope, options.envelope_tolerance))
+        add(report.envelope, more, max, Finding{m.line, 0, *v});
+      const double t = motion_time(m, machine.envelope);
+      double length = 0;
+      if (m.is_arc()) {
+        const PlaneAxes pa = plane_axes(m.plane);
+        const double r = std::hypot(get(m.from_machine, pa.first) - get(m.centre_machine, pa.first),
+                                    get(m.from_machine, pa.second) - get(m.centre_machine, pa.second));
+        length = std::hypot(r * arc_sweep(m), get(m.to_machine, pa.normal) - get(m.from_machine, pa.normal));
+      } else {
+        length = std::hypot(m.to_machine.x - m.from_machine.x, m.to_machine.y - m.from_machine.y,
+                            m.to_machine.z - m.from_machine.z);
+      }
+      if (m.kind == MotionKind::Rapid) {
+        report.time.rapid += t;
+        report.time.rapid_length += length;
+      } else {
+        report.time.feed += t;
+        report.time.feed_length += length;
+        const bool cutting_tool = machine.find_tool(m.tool) != nullptr;
+        if (cutting_tool && m.spindle == SpindleState::Off) {
+          if (!warned_spindle_stopped)
+            add(report.process, more, max,
+                Finding{m.line, 0, "feed move with " + tool_name(m.tool) +
+                                       " and the spindle stopped; expected the spindle started (" +
+                                       machine.gcode.m_codes.spindle_cw + ") before cutting"});
+          warned_spindle_stopped = true;
+        } else {
+          warned_spindle_stopped = false;
+        }
+      }
+    }
+  });
+  if (!report.program_end)
+    add(report.errors, more, max,
+        Finding{report.lines, 0, "the program has no end; expected " + machine.gcode.m_codes.program_end +
+                                     " (or M2/M30) as its last code, as LinuxCNC requires"});
+  report.time.total = report.time.feed + report.time.rapid + report.time.dwell;
+  return report;
+}
+
+std::string CheckReport::str() const {
+  std::string out = file + ": " + std::to_string(lines) + " lines, " + std::to_string(motions) + " moves (" +
+                    std::to_string(rapids) + " rapid, " + std::to_string(feeds) + " feed, " + std::to_string(arcs) +
+                    " arc)\n";
+  for (const Finding& f : errors) {
+    out += file + ":" + std::to_string(f.line);
+    if (f.column > 0) out += ":" + std::to_string(f.column);
+    out += ": error: " + f.message + "\n";
+  }
+  for (const Finding& f : envelope)
+    out += file + ":" + std::to_string(f.line) + ": outside the envelope: " + f.message + "\n";
+  for (const Finding& f : tools)
+    out += file + ":" + std::to_string(f.line) + ":" + std::to_string(f.column) + ": unknown tool: " + f.message + "\n";
+  for (const Finding& f : process) {
+    out += file + ":" + std::to_string(f.line);
+    if (f.column > 0) out += ":" + std::to_string(f.column);
+    out += ": process: " + f.message + "\n";
+  }
+  if (errors_not_listed > 0) out += "... and " + std::to_string(errors_not_listed) + " more problems not listed\n";
+  out += "estimated time: " + format_duration(time.total) + " (feed " + format_duration(time.feed) + " over " +
+         fmt(time.feed_length) + " mm, rapid " + format_duration(time.rapid) + " over " + fmt(time.rapid_length) +
+         " mm, dwell " + format_duration(time.dwell) + "; every move from rest to rest";
+  if (time.program_stops > 0)
+    out += "; " + std::to_string(time.program_stops) + " program stop" + (time.program_stops == 1 ? "" : "s") +
+           " not counted";
+  if (time.tool_changes > 0)
+    out += "; " + std::to_string(time.tool_changes) + " tool change" + (time.tool_changes == 1 ? "" : "s") +
+           " not timed";
+  out += ")\n";
+  const int n = problems();
+  out += file + ": " + (n == 0 ? std::string("clean") : std::to_string(n) + (n == 1 ? " problem" : " problems")) + "\n";
+  return out;
+}
+
+}  // namespace hybridctl::gcode
