@@ -119,15 +119,18 @@ struct DenseGrid {
   }
 };
 
-// 0 on the solid's voxels, infinity elsewhere.
-DenseGrid<double> distance_seed(const Solid& solid, const IndexBox& box) {
-  DenseGrid<double> g(box, kInf);
+// 0 on the solid's voxels, infinity elsewhere. Squared distances in whole voxels (balls,
+// axial bodies) are integers that float holds exactly up to 2^24 (a radius of 4096
+// voxels), at half the memory traffic of double; ellipsoids' scaled ones need double.
+template <typename T>
+DenseGrid<T> distance_seed(const Solid& solid, const IndexBox& box) {
+  DenseGrid<T> g(box, std::numeric_limits<T>::infinity());
   const IndexBox inside = box_intersection(box, solid.bounding_box());
   if (inside.empty()) return g;
   tbb::parallel_for(tbb::blocked_range<int>(inside.lo.z, inside.hi.z), [&](const tbb::blocked_range<int>& r) {
     for (int z = r.begin(); z != r.end(); ++z)
       for (int y = inside.lo.y; y < inside.hi.y; ++y) {
-        double* line = g.values.data() + g.index(0, y - box.lo.y, z - box.lo.z) - box.lo.x;  // indexed by x
+        T* line = g.values.data() + g.index(0, y - box.lo.y, z - box.lo.z) - box.lo.x;  // indexed by x
         for (int w = inside.lo.x >> 6; w <= (inside.hi.x - 1) >> 6; ++w)
           for (std::uint64_t bits = solid.word_at(w, y, z); bits; bits &= bits - 1) {
             const int x = w * 64 + std::countr_zero(bits);
@@ -142,8 +145,8 @@ DenseGrid<double> distance_seed(const Solid& solid, const IndexBox& box) {
 // Huttenlocher), written back to `f`. Exact minimum of the computed expressions: at
 // each p the neighbouring parabolas of the envelope are checked too. Values above
 // `limit` become infinity: later passes only add to them and the caller thresholds.
-void envelope(double* f, int n, double w, double limit, std::vector<double>& z, std::vector<int>& v,
-              std::vector<double>& out) {
+template <typename T>
+void envelope(T* f, int n, double w, double limit, std::vector<double>& z, std::vector<int>& v, std::vector<T>& out) {
   z.resize(std::size_t(n) + 1);
   v.resize(std::size_t(n));
   out.resize(std::size_t(n));
@@ -160,7 +163,7 @@ void envelope(double* f, int n, double w, double limit, std::vector<double>& z, 
     double s;
     while (true) {
       const int p = v[std::size_t(k)];
-      s = ((f[q] + w * double(q) * double(q)) - (f[p] + w * double(p) * double(p))) / (2.0 * w * double(q - p));
+      s = ((double(f[q]) + w * double(q) * double(q)) - (double(f[p]) + w * double(p) * double(p))) / (2.0 * w * double(q - p));
       if (s <= z[std::size_t(k)] && k > 0) {
         --k;
       } else {
@@ -176,18 +179,19 @@ void envelope(double* f, int n, double w, double limit, std::vector<double>& z, 
   int j = 0;
   for (int p = 0; p < n; ++p) {
     while (z[std::size_t(j) + 1] < double(p)) ++j;
-    auto value = [&](int site) { return f[site] + w * double((p - site) * (p - site)); };
+    auto value = [&](int site) { return double(f[site]) + w * double((p - site) * (p - site)); };
     double best = value(v[std::size_t(j)]);
     if (j > 0) best = std::min(best, value(v[std::size_t(j) - 1]));
     if (j < k) best = std::min(best, value(v[std::size_t(j) + 1]));
-    out[std::size_t(p)] = best <= limit ? best : kInf;
+    out[std::size_t(p)] = best <= limit ? T(best) : std::numeric_limits<T>::infinity();
   }
   std::copy(out.begin(), out.begin() + n, f);
 }
 
 // First pass over seeds (0 on the solid, infinity elsewhere): the distance to the
 // nearest seed on the line, by a sweep each way. Returns false when nothing changed.
-bool seed_distances(double* f, int n, double w, double limit, std::vector<int>& nearest) {
+template <typename T>
+bool seed_distances(T* f, int n, double w, double limit, std::vector<int>& nearest) {
   nearest.assign(std::size_t(n), -1);
   int last = -1;
   bool any_seed = false, any_gap = false;
@@ -208,7 +212,7 @@ bool seed_distances(double* f, int n, double w, double limit, std::vector<int>& 
     if (nearest[std::size_t(p)] >= 0) d = p - nearest[std::size_t(p)];
     if (last >= 0) d = std::min(d, last - p);
     const double value = w * double(d) * double(d);
-    f[p] = value <= limit ? value : kInf;
+    f[p] = value <= limit ? T(value) : std::numeric_limits<T>::infinity();
   }
   return true;
 }
@@ -216,11 +220,13 @@ bool seed_distances(double* f, int n, double w, double limit, std::vector<int>& 
 // One pass of the separable distance transform along `axis`:
 // f(p) <- min_q f(q) + w (p - q)^2. `seeds` says the grid still holds only 0 and
 // infinity (the first pass).
-void distance_pass(DenseGrid<double>& g, Axis axis, double w, double limit, bool seeds) {
+template <typename T>
+void distance_pass(DenseGrid<T>& g, Axis axis, double w, double limit, bool seeds) {
   const int n = g.size(axis);
   const std::size_t stride = g.stride(axis);
   g.for_each_line_block(axis, [&](std::size_t first, int count) {
-    thread_local std::vector<double> buffer, z, out;
+    thread_local std::vector<T> buffer, out;
+    thread_local std::vector<double> z;
     thread_local std::vector<int> v;
     buffer.resize(std::size_t(n) * std::size_t(count));
     // Gather `count` neighbouring lines (one cache line per step), transform, scatter.
@@ -229,7 +235,7 @@ void distance_pass(DenseGrid<double>& g, Axis axis, double w, double limit, bool
         buffer[std::size_t(j) * std::size_t(n) + std::size_t(q)] = g.values[first + std::size_t(q) * stride + std::size_t(j)];
     bool changed = false;
     for (int j = 0; j < count; ++j) {
-      double* line = buffer.data() + std::size_t(j) * std::size_t(n);
+      T* line = buffer.data() + std::size_t(j) * std::size_t(n);
       if (seeds) {
         changed |= seed_distances(line, n, w, limit, v);
         continue;
@@ -238,7 +244,7 @@ void distance_pass(DenseGrid<double>& g, Axis axis, double w, double limit, bool
       bool all_zero = true, all_inf = true;
       for (int q = 0; q < n && (all_zero || all_inf); ++q) {
         all_zero = all_zero && line[q] == 0;
-        all_inf = all_inf && line[q] == kInf;
+        all_inf = all_inf && line[q] == std::numeric_limits<T>::infinity();
       }
       if (all_zero || all_inf) continue;
       envelope(line, n, w, limit, z, v, out);
@@ -270,8 +276,9 @@ Solid solid_where(const DenseGrid<T>& g, Keep keep, const Lattice& lattice, cons
   return out;
 }
 
-Solid threshold_into(const DenseGrid<double>& g, double limit, const Lattice& lattice, const IndexBox& domain) {
-  return solid_where(g, [limit](double v) { return v <= limit; }, lattice, domain);
+template <typename T>
+Solid threshold_into(const DenseGrid<T>& g, double limit, const Lattice& lattice, const IndexBox& domain) {
+  return solid_where(g, [limit](T v) { return double(v) <= limit; }, lattice, domain);
 }
 
 // The radius squared (in voxels^2) of an axial body at each level t along its axis.
@@ -314,7 +321,9 @@ AxialLevels axial_levels(const AxialBody& body, double h) {
 
 // Dilation along one axis by offsets {sign * t : t in [lo, hi]} (hi may be unbounded),
 // OR-ed into `out`: out[p] |= exists s with mask[s] and p - s = sign * t.
-void axial_dilate(const DenseGrid<std::uint8_t>& mask, DenseGrid<std::uint8_t>& out, Axis axis, int sign, int lo,
+// Sources are the voxels where perp <= r2 (the level's radius reaches the solid), read
+// straight from the distances: no mask pass per radius.
+void axial_dilate(const DenseGrid<float>& mask, double r2, DenseGrid<std::uint8_t>& out, Axis axis, int sign, int lo,
                   std::int64_t hi) {
   const int n = mask.size(axis);
   const std::size_t stride = mask.stride(axis);
@@ -328,11 +337,11 @@ void axial_dilate(const DenseGrid<std::uint8_t>& mask, DenseGrid<std::uint8_t>& 
     for (int step = 0; step < n; ++step) {
       const int src = step - lo;
       const int p = sign > 0 ? step : n - 1 - step;
-      const std::uint8_t* source = nullptr;
+      const float* source = nullptr;
       if (src >= 0 && src < n) source = mask.values.data() + base + std::size_t(sign > 0 ? src : n - 1 - src) * stride;
       std::uint8_t* target = out.values.data() + base + std::size_t(p) * stride;
       for (std::size_t i = 0; i < count; ++i) {
-        if (source && source[i * element_stride]) last[i] = src;
+        if (source && double(source[i * element_stride]) <= r2) last[i] = src;
         if (step - last[i] <= hi) target[i * element_stride] = 1;
       }
     }
@@ -361,24 +370,86 @@ Solid solid_from_bytes(const DenseGrid<std::uint8_t>& g, const Lattice& lattice,
   return solid_where(g, [](std::uint8_t v) { return v != 0; }, lattice, domain);
 }
 
-Solid dilate_axial(const Solid& solid, const AxialBody& body, const IndexBox& work, const IndexBox& domain) {
-  const double h = solid.voxel_size();
-  const Axis a = body.direction.axis;
-  DenseGrid<double> perp = distance_seed(solid, work);
-  const AxialLevels levels = axial_levels(body, h);
+double widest_radius_sq(const AxialLevels& levels) {
   double widest = levels.tail_radius_sq;
   for (double r2 : levels.radius_sq) widest = std::max(widest, r2);
+  return widest;
+}
+
+// Squared distances across `axis` (in the planes it is normal to) to the solid, up to
+// `widest`: what every axial body along that axis needs, so bodies share it.
+DenseGrid<float> distance_across(const Solid& solid, Axis axis, const IndexBox& work, double widest) {
+  DenseGrid<float> perp = distance_seed<float>(solid, work);
   bool first_pass = true;
   for (Axis other : {Axis::X, Axis::Y, Axis::Z}) {
-    if (other == a) continue;
+    if (other == axis) continue;
     distance_pass(perp, other, 1.0, widest, first_pass);
     first_pass = false;
   }
+  return perp;
+}
 
+// When levels 0..c of a body are exactly a hemisphere of radius c voxels centred at
+// level c, and the levels above hold the ball's upper half (a ball-end cutter's flutes),
+// returns c: the tip is then the whole ball. 0 otherwise.
+int ball_tip_levels(const AxialLevels& levels) {
+  const int n = int(levels.radius_sq.size());
+  if (n == 0 || levels.radius_sq[0] != 0) return 0;
+  int c = 0;
+  while (c + 1 < n && levels.radius_sq[std::size_t(c) + 1] > levels.radius_sq[std::size_t(c)]) ++c;
+  if (c < 2) return 0;
+  auto level_sq = [&](int t) {
+    if (t < n) return levels.radius_sq[std::size_t(t)];
+    return levels.tail_from >= 0 && t >= levels.tail_from ? levels.tail_radius_sq : -1.0;
+  };
+  for (int t = 0; t <= 2 * c; ++t) {
+    const double ball = double(c) * double(c) - double(t - c) * double(t - c);
+    if (t <= c ? level_sq(t) != ball : level_sq(t) < ball) return 0;
+  }
+  return c;
+}
+
+// The dilation by an axial body from the distances across its axis: level t of the body
+// with radius r_t reaches p when the solid comes within r_t of p - t * direction.
+Solid sweep_axial(const DenseGrid<float>& perp, const AxialBody& body, const Lattice& lattice, const IndexBox& domain) {
+  const AxialLevels levels = axial_levels(body, lattice.voxel_size);
+  const Axis a = body.direction.axis;
+  DenseGrid<std::uint8_t> result(perp.box, 0);
+  // A ball-end tip: its levels are a whole ball's, which one more distance pass along the
+  // axis gives at once instead of one sweep per level.
+  const int tip = ball_tip_levels(levels);
+  if (tip > 0) {
+    // The ball's centres lie `tip` levels along the body from the voxels it reaches, so
+    // the grid reaches `tip` levels further back.
+    const int shift = body.direction.sign * tip;
+    IndexBox box = perp.box;
+    Index3 lo = box.lo, hi = box.hi;
+    if (shift > 0) component(lo, a) -= shift; else component(hi, a) -= shift;
+    box = {lo, hi};
+    DenseGrid<float> ball(box, std::numeric_limits<float>::infinity());
+    const Index3 off{perp.box.lo.x - box.lo.x, perp.box.lo.y - box.lo.y, perp.box.lo.z - box.lo.z};
+    tbb::parallel_for(tbb::blocked_range<int>(0, perp.nz), [&](const tbb::blocked_range<int>& r) {
+      for (int z = r.begin(); z != r.end(); ++z)
+        for (int y = 0; y < perp.ny; ++y)
+          std::copy_n(perp.values.data() + perp.index(0, y, z), perp.nx, ball.values.data() + ball.index(off.x, y + off.y, z + off.z));
+    });
+    const double r2 = double(tip) * double(tip);
+    distance_pass(ball, a, 1.0, r2, false);
+    // Voxel p (grid of perp) is reached when the ball grid at p - shift is within r.
+    tbb::parallel_for(tbb::blocked_range<int>(0, perp.nz), [&](const tbb::blocked_range<int>& r) {
+      for (int z = r.begin(); z != r.end(); ++z)
+        for (int y = 0; y < perp.ny; ++y)
+          for (int x = 0; x < perp.nx; ++x) {
+            Index3 src{x + off.x, y + off.y, z + off.z};
+            component(src, a) -= shift;
+            if (double(ball.values[ball.index(src.x, src.y, src.z)]) <= r2) result.values[result.index(x, y, z)] = 1;
+          }
+    });
+  }
   // Group levels of equal radius into runs [lo, hi] so each radius is thresholded once.
   std::map<double, std::vector<std::pair<int, std::int64_t>>> runs;
   const int n = int(levels.radius_sq.size());
-  for (int t = 0; t < n;) {
+  for (int t = tip; t < n;) {
     const double r2 = levels.radius_sq[std::size_t(t)];
     int end = t;
     while (end + 1 < n && levels.radius_sq[std::size_t(end) + 1] == r2) ++end;
@@ -392,15 +463,15 @@ Solid dilate_axial(const Solid& solid, const AxialBody& body, const IndexBox& wo
     runs[levels.tail_radius_sq].push_back({std::max(n, levels.tail_from), kUnboundedExtent});
   }
 
-  DenseGrid<std::uint8_t> result(work, 0), mask(work, 0);
-  for (const auto& [r2, intervals] : runs) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mask.values.size(), 1 << 16),
-                      [&, r2 = r2](const tbb::blocked_range<std::size_t>& r) {
-                        for (std::size_t i = r.begin(); i != r.end(); ++i) mask.values[i] = perp.values[i] <= r2;
-                      });
-    for (const auto& [lo, hi] : intervals) axial_dilate(mask, result, a, body.direction.sign, lo, hi);
-  }
-  return solid_from_bytes(result, solid.lattice(), domain);
+  for (const auto& [r2, intervals] : runs)
+    for (const auto& [lo, hi] : intervals) axial_dilate(perp, r2, result, a, body.direction.sign, lo, hi);
+  return solid_from_bytes(result, lattice, domain);
+}
+
+Solid dilate_axial(const Solid& solid, const AxialBody& body, const IndexBox& work, const IndexBox& domain) {
+  const AxialLevels levels = axial_levels(body, solid.voxel_size());
+  const DenseGrid<float> perp = distance_across(solid, body.direction.axis, work, widest_radius_sq(levels));
+  return sweep_axial(perp, body, solid.lattice(), domain);
 }
 
 Solid dilate_brute_force(const Solid& solid, const std::vector<Index3>& offsets, const IndexBox& domain) {
@@ -412,6 +483,60 @@ Solid dilate_brute_force(const Solid& solid, const std::vector<Index3>& offsets,
     }
   });
   return out;
+}
+
+// The Minkowski sum as a union of shifted copies, 64 voxels a word: offsets with the
+// same (dy, dz) share one pass over each source row. Cost ~ offsets x occupied rows x
+// words per row, which beats the distance transforms for small beads and balls.
+Solid dilate_shifts(const Solid& solid, const std::vector<Index3>& offsets, const IndexBox& source, const IndexBox& domain) {
+  Solid out(solid.lattice(), domain);
+  if (offsets.empty() || source.empty()) return out;
+  std::map<std::pair<int, int>, std::vector<int>> by_row;  // (dy, dz) -> dx values
+  for (const Index3& d : offsets) by_row[{d.y, d.z}].push_back(d.x);
+  const IndexBox store = solid.storage_box();
+  const int sw0 = solid.first_word(), swn = solid.words_per_row();
+  const int ow0 = out.first_word(), own = out.words_per_row();
+  // Which source rows hold anything, so empty space costs nothing.
+  const int sy0 = source.lo.y, sny = source.hi.y - source.lo.y, snz = source.hi.z - source.lo.z;
+  std::vector<std::uint8_t> occupied(std::size_t(sny) * std::size_t(snz), 0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, snz), [&](const tbb::blocked_range<int>& r) {
+    for (int k = r.begin(); k != r.end(); ++k)
+      for (int j = 0; j < sny; ++j) {
+        const int y = sy0 + j, z = source.lo.z + k;
+        if (y < store.lo.y || y >= store.hi.y || z < store.lo.z || z >= store.hi.z) continue;
+        for (std::uint64_t w : solid.row(y, z))
+          if (w) {
+            occupied[std::size_t(k) * std::size_t(sny) + std::size_t(j)] = 1;
+            break;
+          }
+      }
+  });
+  tbb::parallel_for(tbb::blocked_range<int>(domain.lo.z, domain.hi.z), [&](const tbb::blocked_range<int>& r) {
+    for (int z = r.begin(); z != r.end(); ++z)
+      for (int y = domain.lo.y; y < domain.hi.y; ++y) {
+        auto dst = out.row(y, z);
+        for (const auto& [dyz, dxs] : by_row) {
+          const int ys = y - dyz.first, zs = z - dyz.second;
+          if (ys < source.lo.y || ys >= source.hi.y || zs < source.lo.z || zs >= source.hi.z) continue;
+          if (!occupied[std::size_t(zs - source.lo.z) * std::size_t(sny) + std::size_t(ys - sy0)]) continue;
+          const auto src = solid.row(ys, zs);
+          for (int dx : dxs) {
+            // Output voxel x takes source voxel x - dx.
+            const int q = dx >= 0 ? dx / 64 : -((-dx + 63) / 64);
+            const int rbits = dx - q * 64;  // 0..63
+            for (int w = 0; w < own; ++w) {
+              const int sword = ow0 + w - q - sw0;  // index into src of the word shifted up by rbits
+              std::uint64_t v = 0;
+              if (sword >= 0 && sword < swn) v = src[std::size_t(sword)] << rbits;
+              if (rbits && sword - 1 >= 0 && sword - 1 < swn) v |= src[std::size_t(sword - 1)] >> (64 - rbits);
+              dst[std::size_t(w)] |= v;
+            }
+          }
+        }
+      }
+  });
+  // Shifts may reach past the domain inside the last word; clip.
+  return intersect(out, Solid::filled(solid.lattice(), domain));
 }
 
 std::mutex fftw_planner_mutex;  // FFTW's planner is not thread-safe
@@ -596,19 +721,69 @@ IndexBox element_extent(const StructuringElement& element, double h) {
   return box;
 }
 
+namespace {
+
+// Where a dilation works: the result's domain, and the solid's voxels that can reach it
+// (the domain minus the element's extent). Empty source: the result is empty.
+struct Placement {
+  IndexBox ext, domain, source;
+};
+
+Placement place(const Solid& solid, const StructuringElement& element, const IndexBox& requested_domain) {
+  Placement p;
+  p.ext = element_extent(element, solid.voxel_size());
+  const IndexBox bbox = solid.bounding_box();
+  if (requested_domain.empty() && !is_finite_extent(p.ext)) {
+    throw std::invalid_argument("dilation by an infinite element needs a domain to clip to");
+  }
+  p.domain = requested_domain.empty() ? grow(bbox, p.ext) : requested_domain;
+  if (bbox.empty() || p.ext.empty() || p.domain.empty()) return p;
+  const IndexBox& ext = p.ext;
+  const IndexBox reflected_ext{{-(ext.hi.x - 1), -(ext.hi.y - 1), -(ext.hi.z - 1)}, {-ext.lo.x + 1, -ext.lo.y + 1, -ext.lo.z + 1}};
+  p.source = box_intersection(bbox, grow(p.domain, reflected_ext));
+  return p;
+}
+
+}  // namespace
+
+std::vector<Solid> dilate_each(const Solid& solid, const std::vector<StructuringElement>& elements, const IndexBox& domain) {
+  std::vector<Solid> out(elements.size());
+  // Axial bodies along one axis: one distance transform across it, over the union of
+  // their working boxes, up to the widest radius among them.
+  for (Axis axis : {Axis::X, Axis::Y, Axis::Z}) {
+    std::vector<std::size_t> group;
+    IndexBox work;
+    double widest = -1;
+    for (std::size_t i = 0; i < elements.size(); ++i) {
+      const auto* body = std::get_if<AxialBody>(&elements[i]);
+      if (!body || body->direction.axis != axis) continue;
+      const Placement p = place(solid, elements[i], domain);
+      if (p.source.empty()) {
+        out[i] = Solid(solid.lattice(), p.domain);
+        continue;
+      }
+      const IndexBox w = box_union(p.source, p.domain);
+      work = work.empty() ? w : box_union(work, w);
+      widest = std::max(widest, widest_radius_sq(axial_levels(*body, solid.voxel_size())));
+      group.push_back(i);
+    }
+    if (group.empty()) continue;
+    const DenseGrid<float> perp = distance_across(solid, axis, work, widest);
+    for (std::size_t i : group)
+      out[i] = sweep_axial(perp, std::get<AxialBody>(elements[i]), solid.lattice(), place(solid, elements[i], domain).domain);
+  }
+  for (std::size_t i = 0; i < elements.size(); ++i)
+    if (!std::holds_alternative<AxialBody>(elements[i])) out[i] = dilate(solid, elements[i], domain);
+  return out;
+}
+
 Solid dilate(const Solid& solid, const StructuringElement& element, const IndexBox& requested_domain,
              MorphologyMethod method) {
   const double h = solid.voxel_size();
-  const IndexBox ext = element_extent(element, h);
-  const IndexBox bbox = solid.bounding_box();
-  if (requested_domain.empty() && !is_finite_extent(ext)) {
-    throw std::invalid_argument("dilation by an infinite element needs a domain to clip to");
-  }
-  const IndexBox domain = requested_domain.empty() ? grow(bbox, ext) : requested_domain;
-  if (bbox.empty() || ext.empty() || domain.empty()) return Solid(solid.lattice(), domain);
-  // Sources that can reach the domain: domain minus the element's extent.
-  const IndexBox reflected_ext{{-(ext.hi.x - 1), -(ext.hi.y - 1), -(ext.hi.z - 1)}, {-ext.lo.x + 1, -ext.lo.y + 1, -ext.lo.z + 1}};
-  const IndexBox source = box_intersection(bbox, grow(domain, reflected_ext));
+  const Placement placement = place(solid, element, requested_domain);
+  const IndexBox& ext = placement.ext;
+  const IndexBox& domain = placement.domain;
+  const IndexBox& source = placement.source;
   if (source.empty()) return Solid(solid.lattice(), domain);
 
   if (method == MorphologyMethod::BruteForce || method == MorphologyMethod::Fft) {
@@ -619,10 +794,23 @@ Solid dilate(const Solid& solid, const StructuringElement& element, const IndexB
     if (method == MorphologyMethod::BruteForce) return dilate_brute_force(solid, offsets, domain);
     return dilate_fft(solid, offsets, source, domain);
   }
+  const bool finite_element = is_finite_extent(ext);
+  if (method == MorphologyMethod::Shifts) {
+    if (!finite_element) throw std::invalid_argument("the shift method needs a finite element");
+    return dilate_shifts(solid, offsets_of(element, h), source, domain);
+  }
+  if (method == MorphologyMethod::Auto && finite_element && !std::holds_alternative<AxialBody>(element)) {
+    const IndexBox size = ext;
+    const double box_voxels = double(size.hi.x - size.lo.x) * double(size.hi.y - size.lo.y) * double(size.hi.z - size.lo.z);
+    if (box_voxels <= 4.0 * double(kShiftOffsetLimit)) {
+      std::vector<Index3> offsets = offsets_of(element, h);
+      if (offsets.size() <= kShiftOffsetLimit) return dilate_shifts(solid, offsets, source, domain);
+    }
+  }
   // The working box holds the sources and the domain.
   const IndexBox work = box_union(source, domain);
   if (const auto* ball = std::get_if<Ball>(&element)) {
-    DenseGrid<double> g = distance_seed(solid, work);
+    DenseGrid<float> g = distance_seed<float>(solid, work);
     const double r = ball->radius / h;
     distance_pass(g, Axis::X, 1.0, r * r, true);
     distance_pass(g, Axis::Y, 1.0, r * r, false);
@@ -630,13 +818,15 @@ Solid dilate(const Solid& solid, const StructuringElement& element, const IndexB
     return threshold_into(g, r * r, solid.lattice(), domain);
   }
   if (const auto* e = std::get_if<Ellipsoid>(&element)) {
-    DenseGrid<double> g = distance_seed(solid, work);
+    DenseGrid<double> g = distance_seed<double>(solid, work);
     distance_pass(g, Axis::X, (h / e->radii.x) * (h / e->radii.x), 1.0, true);
     distance_pass(g, Axis::Y, (h / e->radii.y) * (h / e->radii.y), 1.0, false);
     distance_pass(g, Axis::Z, (h / e->radii.z) * (h / e->radii.z), 1.0, false);
     return threshold_into(g, 1.0, solid.lattice(), domain);
   }
   if (const auto* body = std::get_if<AxialBody>(&element)) return dilate_axial(solid, *body, work, domain);
+  if (method == MorphologyMethod::DistanceTransform)
+    throw std::invalid_argument("distance transforms serve balls, ellipsoids and axial bodies only");
   return dilate_fft(solid, offsets_of(element, h), source, domain);
 }
 
@@ -676,7 +866,7 @@ double farthest_distance(const Solid& from, const Solid& to) {
   const IndexBox tb = to.bounding_box();
   if (tb.empty()) return std::numeric_limits<double>::infinity();
   const IndexBox work = box_union(fb, tb);
-  DenseGrid<double> g = distance_seed(to, work);
+  DenseGrid<double> g = distance_seed<double>(to, work);
   distance_pass(g, Axis::X, 1.0, kInf, true);
   distance_pass(g, Axis::Y, 1.0, kInf, false);
   distance_pass(g, Axis::Z, 1.0, kInf, false);

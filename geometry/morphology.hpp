@@ -78,15 +78,26 @@ StructuringElement reflected(const StructuringElement& element);
 std::vector<Index3> offsets_of(const StructuringElement& element, double voxel_size, int max_length_voxels = 0);
 
 enum class MorphologyMethod {
-  Auto,         // the fastest exact method for the element (distance transforms, sweeps)
-  Fft,          // convolution of indicator functions with FFTW; any element, finite only
-  BruteForce,   // the definition, for tests on small grids
+  Auto,               // the fastest exact method for the element (see below)
+  DistanceTransform,  // separable squared-distance transforms: balls, ellipsoids, axial bodies
+  Shifts,             // union of shifted copies, 64 voxels a word; any finite element
+  Fft,                // convolution of indicator functions with FFTW; any finite element
+  BruteForce,         // the definition, for tests on small grids
 };
+
+// Auto picks Shifts for elements of at most kShiftOffsetLimit offsets (small beads and
+// balls: measured faster than the transforms, bench/morphology_bench), distance
+// transforms for larger balls, ellipsoids and every axial body, FFT for other large sets.
+inline constexpr std::size_t kShiftOffsetLimit = 400;
 
 // Dilation S (+) B, clipped to `domain` (needed for infinite elements; pass an empty box
 // for "wherever the result reaches", finite elements only).
 Solid dilate(const Solid& solid, const StructuringElement& element, const IndexBox& domain = {},
              MorphologyMethod method = MorphologyMethod::Auto);
+// The dilations of one solid by several elements, each clipped to `domain`: axial bodies
+// along the same axis share one distance transform across it (a cutter, its shank and
+// holder, and every other tool from the same side).
+std::vector<Solid> dilate_each(const Solid& solid, const std::vector<StructuringElement>& elements, const IndexBox& domain);
 // Erosion S (-) B = { p : p + B inside S }, computed as the complement of the dilation
 // of the complement by -B.
 Solid erode(const Solid& solid, const StructuringElement& element, MorphologyMethod method = MorphologyMethod::Auto);

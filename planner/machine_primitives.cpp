@@ -1,5 +1,7 @@
 #include "planner/machine_primitives.hpp"
 
+#include <deque>
+
 #include <cmath>
 #include <limits>
 
@@ -153,8 +155,14 @@ std::vector<Primitive> machine_primitives(const config::Machine& m, const Solid&
         }
       }
 
+  // Removal regions are computed together: tools from the same side share the design's
+  // distance transforms (primitive_shapes.hpp, removal_regions).
+  std::deque<Instrument> instruments;
+  std::vector<Primitive> removals;
+  std::vector<RemovalRequest> requests;
   for (const auto& tool : m.tools)
-    for (const auto& setup : m.setups)
+    for (const auto& setup : m.setups) {
+      const Instrument* in = &instruments.emplace_back(tool_instrument(tool, setup.approach));
       for (const auto kind : tool.primitives) {
         Primitive p;
         p.mode = Mode::Subtractive;
@@ -162,18 +170,32 @@ std::vector<Primitive> machine_primitives(const config::Machine& m, const Solid&
         p.tool_number = tool.number;
         p.setup = setup.name;
         p.cost_per_mm3 = tool.cost_per_mm3;
-        const Instrument in = tool_instrument(tool, setup.approach);
         const std::string tool_words = "T" + std::to_string(tool.number) + " (" + tool.name + ") " + setup_words(setup);
         if (kind == config::PrimitiveKind::SmMax) {
           p.kind = PrimitiveKind::SmMax;
           p.label = "SM-max " + tool_words;
-          add(p, [&] { return subtractive_maximal(design, in, domain); });
         } else if (kind == config::PrimitiveKind::SmCons) {
           p.kind = PrimitiveKind::SmCons;
           p.label = "SM-cons " + tool_words;
-          add(p, [&] { return subtractive_conservative(design, in, domain); });
+        } else {
+          continue;
         }
+        removals.push_back(std::move(p));
+        requests.push_back({in, kind == config::PrimitiveKind::SmMax});
       }
+    }
+  if (!requests.empty()) {
+    if (progress) progress(out.size(), total, removals.front().label);
+    const std::size_t before = out.size();
+    std::vector<Solid> regions = removal_regions(design, requests, domain, [&](std::size_t i) {
+      if (progress) progress(before + i + 1, total, i + 1 < removals.size() ? removals[i + 1].label : "done");
+    });
+    for (std::size_t i = 0; i < removals.size(); ++i) {
+      removals[i].region = std::move(regions[i]);
+      removals[i].name = "P" + std::to_string(out.size() + 1);
+      out.push_back(std::move(removals[i]));
+    }
+  }
   if (progress) progress(out.size(), total, "done");
   return out;
 }

@@ -76,4 +76,50 @@ Solid subtractive_conservative(const Solid& design, const Instrument& instrument
   return removal_region(design, instrument.body, instrument.cutting, domain);
 }
 
+std::vector<Solid> removal_regions(const Solid& design, const std::vector<RemovalRequest>& requests, const IndexBox& domain,
+                                   const std::function<void(std::size_t)>& done) {
+  const double h = design.voxel_size();
+  // One working box for all: padded by the farthest-reaching cutter.
+  std::vector<StructuringElement> all_cutting;
+  for (const auto& r : requests) all_cutting.insert(all_cutting.end(), r.instrument->cutting.begin(), r.instrument->cutting.end());
+  const IndexBox work = padded(domain, all_cutting, h);
+
+  // Every instrument's reflected cutter and body elements, once each, grown together.
+  std::vector<const Instrument*> instruments;
+  for (const auto& r : requests)
+    if (std::find(instruments.begin(), instruments.end(), r.instrument) == instruments.end()) instruments.push_back(r.instrument);
+  std::vector<StructuringElement> elements;
+  struct Span {
+    std::size_t cutting_begin, body_begin, end;
+  };
+  std::vector<Span> spans;
+  for (const Instrument* in : instruments) {
+    Span sp{elements.size(), 0, 0};
+    for (const auto& e : in->cutting) elements.push_back(geometry::reflected(e));
+    sp.body_begin = elements.size();
+    for (const auto& e : in->body) elements.push_back(geometry::reflected(e));
+    sp.end = elements.size();
+    spans.push_back(sp);
+  }
+  const std::vector<Solid> grown = geometry::dilate_each(design, elements, work);
+
+  std::vector<Solid> out;
+  out.reserve(requests.size());
+  for (std::size_t i = 0; i < requests.size(); ++i) {
+    const RemovalRequest& r = requests[i];
+    const Span& sp = spans[std::size_t(std::find(instruments.begin(), instruments.end(), r.instrument) - instruments.begin())];
+    const std::size_t first = r.maximal ? sp.cutting_begin : sp.body_begin;
+    Solid obstacle = design;
+    if (first < sp.end) {
+      obstacle = Solid(design.lattice(), work);
+      for (std::size_t e = first; e < sp.end; ++e) obstacle = unite(obstacle, grown[e]);
+      obstacle = intersect(obstacle, Solid::filled(design.lattice(), work));
+    }
+    const Solid kept = erode_union(obstacle, reflected_all(r.instrument->cutting));
+    out.push_back(subtract(Solid::filled(design.lattice(), domain), kept));
+    if (done) done(i);
+  }
+  return out;
+}
+
 }  // namespace hybridctl::planner

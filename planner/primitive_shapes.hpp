@@ -11,6 +11,7 @@
 //   SM-max  P = domain - ((S (+) -D) (-) B)   the most that can be removed, never cutting S
 //   SM-cons P = domain - ((S (+) -C) (-) B)   conservative over-cut; domain - (S (-) B)
 
+#include <functional>
 #include <vector>
 
 #include "geometry/morphology.hpp"
@@ -30,5 +31,18 @@ geometry::Solid subtractive_maximal(const geometry::Solid& design, const Instrum
                                     const geometry::IndexBox& domain);
 geometry::Solid subtractive_conservative(const geometry::Solid& design, const Instrument& instrument,
                                          const geometry::IndexBox& domain);
+
+// Many removal regions at once: SM-max (`maximal`) or SM-cons of each instrument. The
+// design's growth by every instrument's cutter and body is computed in one batch, so
+// tools approaching along the same axis share a distance transform, and an
+// instrument's SM-max and SM-cons share its body's growth. Equal to calling
+// subtractive_maximal / subtractive_conservative one by one. `done(i)` reports region i.
+struct RemovalRequest {
+  const Instrument* instrument = nullptr;
+  bool maximal = true;
+};
+std::vector<geometry::Solid> removal_regions(const geometry::Solid& design, const std::vector<RemovalRequest>& requests,
+                                             const geometry::IndexBox& domain,
+                                             const std::function<void(std::size_t)>& done = {});
 
 }  // namespace hybridctl::planner

@@ -56,6 +56,7 @@ std::vector<Case> finite_cases() {
       {"flat mill +X", flat_mill_with_shank_and_holder({Axis::X, +1})},
       {"flat mill -Y", flat_mill_with_shank_and_holder({Axis::Y, -1})},
       {"ball-end mill +Z", ball_end_mill({Axis::Z, +1})},
+      {"ball-end mill -X (whole-ball tip path, other way)", ball_end_mill({Axis::X, -1})},
       {"bull-nose mill -X", bull_nose_mill({Axis::X, -1})},
       {"cylinder bead", cylinder_body({Axis::Z, +1}, 1.2, 0.5)},
       {"odd voxel set", VoxelOffsets{{{0, 0, 0}, {3, -1, 0}, {-2, 2, 1}, {0, 0, -3}}}},
@@ -73,6 +74,23 @@ TEST(Morphology, FastDilationEqualsTheBruteForceMinkowskiSum) {
       EXPECT_EQ(fast, brute) << c.name << " seed " << seed;
     }
   }
+}
+
+TEST(Morphology, EveryExactMethodEqualsTheBruteForceMinkowskiSum) {
+  for (const Case& c : finite_cases()) {
+    const Solid s = lumpy(4);
+    const Solid brute = dilate(s, c.element, {}, MorphologyMethod::BruteForce);
+    EXPECT_EQ(dilate(s, c.element, {}, MorphologyMethod::Shifts), brute) << c.name;
+    if (!std::holds_alternative<VoxelOffsets>(c.element)) {
+      EXPECT_EQ(dilate(s, c.element, {}, MorphologyMethod::DistanceTransform), brute) << c.name;
+    }
+  }
+  // Shifts across word boundaries in both directions, into a domain that clips them.
+  Solid row(kLattice, {{-130, 0, 0}, {130, 1, 1}});
+  for (int x : {-129, -64, -63, -1, 0, 63, 64, 127}) row.set({x, 0, 0});
+  const StructuringElement far = VoxelOffsets{{{-70, 0, 0}, {65, 0, 0}, {1, 0, 0}, {-1, 0, 0}}};
+  const IndexBox clip{{-150, 0, 0}, {100, 1, 1}};
+  EXPECT_EQ(dilate(row, far, clip, MorphologyMethod::Shifts), dilate(row, far, clip, MorphologyMethod::BruteForce));
 }
 
 TEST(Morphology, FftConvolutionEqualsTheBruteForceMinkowskiSum) {
