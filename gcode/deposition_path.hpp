@@ -1,0 +1,76 @@
+#pragma once
+// Raster deposition: the toolpath that lays down an additive action's region of
+// influence (ROI) layer by layer (docs/toolpaths.md is the full description).
+//
+//   Toolpath p = deposition_path(roi, existing, head, setup);
+//
+// Work frame (gcode/setup_frame.hpp): the setup's approach direction is +Z. Layers of the
+// head's layer_height go bottom-up from the ROI's lowest voxel face. A layer's region is
+// the ROI's voxel slice at the layer's mid-height. Raster lines at hatch_spacing, at an
+// angle that changes from layer to layer, are clipped to the region; deposition is on
+// along the clipped segments only. Between segments the head lifts by travel_clearance
+// above the material under the travel (existing material and everything deposited so
+// far, within the nozzle's radius) and comes down again, with rapids that never descend
+// into material.
+//
+// The programmed point is the bottom of the bead on its axis: the surface the bead is
+// laid on (z = the layer's bottom).
+
+#include <optional>
+#include <vector>
+
+#include "config/machine.hpp"
+#include "gcode/toolpath.hpp"
+#include "geometry/solid.hpp"
+
+namespace hybridctl::gcode {
+
+// Where a layer's contour (a pass along the region's edge, half a bead inside it) goes.
+enum class ContourPass {
+  None,          // rasters only
+  BeforeInfill,  // contour first, then rasters inside it
+  AfterInfill,   // rasters inside the contour first, then the contour
+};
+
+struct DepositionOptions {
+  // Raster angle of layer i, degrees from the work frame's +X towards +Y: the list is
+  // used cyclically. The default alternates 0 and 90 degrees. Any angle is allowed.
+  std::vector<double> raster_angles_deg = {0.0, 90.0};
+  ContourPass contour = ContourPass::None;
+  // How far segment ends stay inside the region along the raster (mm), so that the
+  // bead's end does not spill out. Default: half the bead width.
+  std::optional<double> edge_inset;
+  // Clipped raster segments shorter than this (mm, before the inset) are dropped, and so
+  // are contour chains shorter than it. Default: the bead width.
+  std::optional<double> min_segment_length;
+  // The build plate, mm in the work frame: deposit lying on it is supported. Default: the
+  // bottom face of the lowest voxel of the ROI and the existing material.
+  std::optional<double> build_plate_z;
+  // Deposit is supported when material (existing, deposited, the plate) ends at most this
+  // far (mm) below the layer's bottom. Default: the layer height.
+  std::optional<double> support_gap;
+  // Deposit within this distance (mm, sideways) of supported deposit counts as supported:
+  // a bead may overhang its support by a fraction of its width. Default: half the bead
+  // width.
+  std::optional<double> overhang_reach;
+  // The T number when config::AdditiveHead has no tool_number (machine files before it).
+  int fallback_tool_number = 0;
+};
+
+// The head's T number: its `tool_number` from the machine file when config::AdditiveHead
+// has that field and it is positive, otherwise `fallback`.
+int head_tool_number(const config::AdditiveHead& head, int fallback);
+
+// The deposition toolpath of one additive action.
+//   roi       voxels to deposit, part frame (the action's region of influence)
+//   existing  material present before the action, part frame, same lattice (may be empty)
+//   head      the additive head: bead, layer_height, hatch_spacing, travel_clearance, feed
+//   setup     the setup: its approach becomes the work frame's +Z; its name is recorded
+// Moves are in mm in the work frame. Warnings: overhangs (deposit with nothing below),
+// ROI under existing material (not reachable from the approach side: skipped), dropped
+// short segments. Throws std::invalid_argument on solids on different lattices or a head
+// with a non-positive bead, layer height or hatch spacing.
+Toolpath deposition_path(const geometry::Solid& roi, const geometry::Solid& existing, const config::AdditiveHead& head,
+                         const config::Setup& setup, const DepositionOptions& options = {});
+
+}  // namespace hybridctl::gcode
