@@ -1,9 +1,11 @@
 #include "planner/atoms.hpp"
 
 #include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <bit>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -36,47 +38,88 @@ int AtomDecomposition::atom_at(Index3 v) const {
                  std::size_t(v.x - domain_.lo.x)];
 }
 
+namespace {
+
+// Calls fn(first_label_index, y, z) for every row of the domain, in parallel over z.
+template <typename Fn>
+void for_each_row(const IndexBox& d, Fn fn) {
+  const std::size_t nx = std::size_t(d.hi.x - d.lo.x), ny = std::size_t(d.hi.y - d.lo.y);
+  tbb::parallel_for(tbb::blocked_range<int>(d.lo.z, d.hi.z), [&](const tbb::blocked_range<int>& r) {
+    for (int z = r.begin(); z != r.end(); ++z)
+      for (int y = d.lo.y; y < d.hi.y; ++y)
+        fn((std::size_t(z - d.lo.z) * ny + std::size_t(y - d.lo.y)) * nx, y, z);
+  });
+}
+
+// Calls fn(x) for every x in [x0, x1) set in `solid`'s row (y, z), a word at a time.
+template <typename Fn>
+void for_each_set_in_row(const Solid& solid, int y, int z, int x0, int x1, Fn fn) {
+  for (int w = x0 >> 6; w <= (x1 - 1) >> 6; ++w) {
+    std::uint64_t bits = solid.word_at(w, y, z);
+    while (bits) {
+      const int x = w * 64 + std::countr_zero(bits);
+      bits &= bits - 1;
+      if (x >= x0 && x < x1) fn(x);
+    }
+  }
+}
+
+}  // namespace
+
 void AtomDecomposition::add_primitive(const Solid& primitive) {
   if (!(primitive.lattice() == lattice_)) throw std::invalid_argument("primitive on a different lattice than the atoms");
   const int bit = primitives_++;
   for (AtomCode& c : codes_) c.grow(primitives_);
-  const int old_count = atom_count();
-  // Each old atom a keeps its number for its part outside the primitive; its part
-  // inside gets a new number, made on first sight.
-  std::vector<std::int32_t> inside_id(std::size_t(old_count), -1);
-  std::vector<std::int64_t> outside_count(std::size_t(old_count), 0);
-  const int nx = domain_.hi.x - domain_.lo.x, ny = domain_.hi.y - domain_.lo.y;
-  std::size_t i = 0;
-  for (int z = domain_.lo.z; z < domain_.hi.z; ++z)
-    for (int y = domain_.lo.y; y < domain_.hi.y; ++y)
-      for (int xi = 0; xi < nx; ++xi, ++i) {
-        const int x = domain_.lo.x + xi;
-        const std::int32_t a = labels_[i];
-        if (!((primitive.word_at(x >> 6, y, z) >> (x & 63)) & 1u)) {
-          ++outside_count[std::size_t(a)];
-          continue;
-        }
-        std::int32_t& id = inside_id[std::size_t(a)];
-        if (id < 0) {
-          id = std::int32_t(codes_.size());
-          AtomCode c = codes_[std::size_t(a)];
-          c.set(bit);
-          codes_.push_back(c);
-        }
-        labels_[i] = id;
-      }
-  (void)ny;
-  // Old atoms wholly inside the primitive are now empty: drop them and renumber.
+  const std::size_t old_count = codes_.size();
+  // Pass 1: how much of each old atom lies inside the primitive, and how big it is.
+  using Counts = std::vector<std::int64_t>;
+  tbb::combinable<std::pair<Counts, Counts>> partial([&] { return std::make_pair(Counts(old_count, 0), Counts(old_count, 0)); });
+  const int x0 = domain_.lo.x, x1 = domain_.hi.x;
+  for_each_row(domain_, [&](std::size_t first, int y, int z) {
+    auto& [inside, size] = partial.local();
+    const std::int32_t* row = labels_.data() + first;
+    for (int i = 0; i < x1 - x0; ++i) ++size[std::size_t(row[i])];
+    for_each_set_in_row(primitive, y, z, x0, x1, [&](int x) { ++inside[std::size_t(row[x - x0])]; });
+  });
+  Counts inside(old_count, 0), size(old_count, 0);
+  partial.combine_each([&](const std::pair<Counts, Counts>& p) {
+    for (std::size_t a = 0; a < old_count; ++a) {
+      inside[a] += p.first[a];
+      size[a] += p.second[a];
+    }
+  });
+  // Each old atom keeps its number for its part outside the primitive; its part inside
+  // gets a new one, in atom order, so the numbering does not depend on threads. Old atoms
+  // wholly inside are then empty and dropped.
+  std::vector<std::int32_t> inside_id(old_count, -1);
+  for (std::size_t a = 0; a < old_count; ++a) {
+    if (inside[a] == 0) continue;
+    inside_id[a] = std::int32_t(codes_.size());
+    AtomCode c = codes_[a];
+    c.set(bit);
+    codes_.push_back(c);
+  }
   std::vector<std::int32_t> renumber(codes_.size(), -1);
   std::vector<AtomCode> kept;
   for (std::size_t a = 0; a < codes_.size(); ++a) {
-    if (a < std::size_t(old_count) && outside_count[a] == 0) continue;
+    if (a < old_count && inside[a] == size[a]) continue;
     renumber[a] = std::int32_t(kept.size());
     kept.push_back(codes_[a]);
   }
-  if (kept.size() != codes_.size()) {
-    for (std::int32_t& l : labels_) l = renumber[std::size_t(l)];
-  }
+  const bool dropped = kept.size() != codes_.size();
+  for (std::size_t a = 0; a < old_count; ++a)
+    if (inside_id[a] >= 0) inside_id[a] = renumber[std::size_t(inside_id[a])];
+  // Pass 2: relabel. Inside voxels take their atom's inside part; when atoms were
+  // dropped, the rest are renumbered (inside voxels are marked negative meanwhile).
+  for_each_row(domain_, [&](std::size_t first, int y, int z) {
+    std::int32_t* row = labels_.data() + first;
+    for_each_set_in_row(primitive, y, z, x0, x1, [&](int x) {
+      std::int32_t& l = row[x - x0];
+      l = dropped ? -inside_id[std::size_t(l)] - 2 : inside_id[std::size_t(l)];
+    });
+    if (dropped)
+      for (int i = 0; i < x1 - x0; ++i) row[i] = row[i] < 0 ? -row[i] - 2 : renumber[std::size_t(row[i])];
+  });
   codes_ = std::move(kept);
 }
 
@@ -110,8 +153,15 @@ Solid AtomDecomposition::atom_solid(int atom) const {
 
 Solid AtomDecomposition::union_of(const std::vector<bool>& selected) const {
   Solid out(lattice_, domain_);
-  for_each_voxel_label([&](Index3 v, std::int32_t a) {
-    if (selected[std::size_t(a)]) out.set(v);
+  const int x0 = domain_.lo.x, nx = domain_.hi.x - domain_.lo.x;
+  for_each_row(domain_, [&](std::size_t first, int y, int z) {
+    const std::int32_t* row = labels_.data() + first;
+    auto words = out.row(y, z);
+    for (int i = 0; i < nx; ++i)
+      if (selected[std::size_t(row[i])]) {
+        const int x = x0 + i;
+        words[std::size_t((x >> 6) - out.first_word())] |= std::uint64_t{1} << (x & 63);
+      }
   });
   return out;
 }
@@ -148,21 +198,58 @@ std::vector<AtomMeasures> measure_atoms(const AtomDecomposition& atoms, const So
     out[std::size_t(a)].code = atoms.code(a);
     out[std::size_t(a)].bounding_box = {{INT32_MAX, INT32_MAX, INT32_MAX}, {INT32_MIN, INT32_MIN, INT32_MIN}};
   }
+  // Per-thread partial sums over rows, combined in atom order.
+  struct Partial {
+    std::vector<AtomMeasures> m;
+    std::vector<Vec3> sums;
+  };
   const IndexBox& d = atoms.domain();
-  for (int z = d.lo.z; z < d.hi.z; ++z)
-    for (int y = d.lo.y; y < d.hi.y; ++y)
-      for (int x = d.lo.x; x < d.hi.x; ++x) {
-        AtomMeasures& a = out[std::size_t(atoms.atom_at({x, y, z}))];
-        ++a.voxels;
-        a.voxels_in_design += design.contains({x, y, z});
-        a.voxels_in_core += zone.core.contains({x, y, z});
-        a.voxels_beyond_hull += !zone.hull.contains({x, y, z});
-        IndexBox& b = a.bounding_box;
-        b.lo = {std::min(b.lo.x, x), std::min(b.lo.y, y), std::min(b.lo.z, z)};
-        b.hi = {std::max(b.hi.x, x + 1), std::max(b.hi.y, y + 1), std::max(b.hi.z, z + 1)};
-        Vec3& s = sums[std::size_t(&a - out.data())];
-        s = {s.x + x, s.y + y, s.z + z};
+  tbb::combinable<Partial> partial([&] { return Partial{out, sums}; });
+  const int x0 = d.lo.x, nx = d.hi.x - d.lo.x;
+  tbb::parallel_for(tbb::blocked_range<int>(d.lo.z, d.hi.z), [&](const tbb::blocked_range<int>& r) {
+    Partial& p = partial.local();
+    for (int z = r.begin(); z != r.end(); ++z)
+      for (int y = d.lo.y; y < d.hi.y; ++y) {
+        int x = x0;
+        for (int w = x0 >> 6; w <= (d.hi.x - 1) >> 6; ++w) {
+          const std::uint64_t in = design.word_at(w, y, z), core = zone.core.word_at(w, y, z),
+                              hull = zone.hull.word_at(w, y, z);
+          const int end = std::min(d.hi.x, (w + 1) * 64);
+          for (; x < end; ++x) {
+            const int atom = atoms.atom_at_unchecked(x - x0, y, z);
+            AtomMeasures& a = p.m[std::size_t(atom)];
+            const int bit = x & 63;
+            ++a.voxels;
+            a.voxels_in_design += (in >> bit) & 1u;
+            a.voxels_in_core += (core >> bit) & 1u;
+            a.voxels_beyond_hull += !((hull >> bit) & 1u);
+            IndexBox& b = a.bounding_box;
+            b.lo = {std::min(b.lo.x, x), std::min(b.lo.y, y), std::min(b.lo.z, z)};
+            b.hi = {std::max(b.hi.x, x + 1), std::max(b.hi.y, y + 1), std::max(b.hi.z, z + 1)};
+            Vec3& s = p.sums[std::size_t(atom)];
+            s = {s.x + x, s.y + y, s.z + z};
+          }
+        }
+        (void)nx;
       }
+  });
+  partial.combine_each([&](const Partial& p) {
+    for (int i = 0; i < m; ++i) {
+      AtomMeasures& a = out[std::size_t(i)];
+      const AtomMeasures& q = p.m[std::size_t(i)];
+      a.voxels += q.voxels;
+      a.voxels_in_design += q.voxels_in_design;
+      a.voxels_in_core += q.voxels_in_core;
+      a.voxels_beyond_hull += q.voxels_beyond_hull;
+      IndexBox& b = a.bounding_box;
+      const IndexBox& c = q.bounding_box;
+      b.lo = {std::min(b.lo.x, c.lo.x), std::min(b.lo.y, c.lo.y), std::min(b.lo.z, c.lo.z)};
+      b.hi = {std::max(b.hi.x, c.hi.x), std::max(b.hi.y, c.hi.y), std::max(b.hi.z, c.hi.z)};
+      Vec3& s = sums[std::size_t(i)];
+      const Vec3& t = p.sums[std::size_t(i)];
+      s = {s.x + t.x, s.y + t.y, s.z + t.z};
+    }
+  });
   const double h = atoms.lattice().voxel_size, v = h * h * h;
   for (int i = 0; i < m; ++i) {
     AtomMeasures& a = out[std::size_t(i)];

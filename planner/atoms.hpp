@@ -40,6 +40,11 @@ class AtomDecomposition {
   const IndexBox& domain() const { return domain_; }
   // The atom of a voxel of the domain.
   int atom_at(Index3 v) const;
+  // The same without the range check; x counted from the domain's low x.
+  int atom_at_unchecked(int x_from_low, int y, int z) const {
+    const std::size_t nx = std::size_t(domain_.hi.x - domain_.lo.x), ny = std::size_t(domain_.hi.y - domain_.lo.y);
+    return labels_[(std::size_t(z - domain_.lo.z) * ny + std::size_t(y - domain_.lo.y)) * nx + std::size_t(x_from_low)];
+  }
   // The voxels of one atom, or of a set of atoms (selected[atom] true), as a solid.
   Solid atom_solid(int atom) const;
   Solid union_of(const std::vector<bool>& selected) const;
