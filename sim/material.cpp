@@ -1,0 +1,319 @@
+#include "sim/material.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <climits>
+#include <cstdio>
+#include <stdexcept>
+
+namespace hybridctl::sim {
+namespace {
+
+using geometry::Index3;
+using geometry::IndexBox;
+
+constexpr int kWordBits = geometry::Solid::kWordBits;
+
+int word_of(int x) { return x >> 6; }  // floor division by 64 (arithmetic shift)
+
+// Bits [lo, hi) of a word, 0 <= lo < hi <= 64.
+std::uint64_t bit_range(int lo, int hi) {
+  const std::uint64_t upper = hi == kWordBits ? ~std::uint64_t{0} : (std::uint64_t{1} << hi) - 1;
+  return upper & (~std::uint64_t{0} << lo);
+}
+
+// The rows of one move's swept voxels over a box, 64 voxels a word, in scratch storage.
+struct RowMask {
+  IndexBox box;  // rows y, z; voxels x within
+  int w0 = 0, w1 = 0;
+  std::vector<std::uint64_t>& words;
+
+  explicit RowMask(std::vector<std::uint64_t>& storage) : words(storage) {}
+  bool empty() const { return box.empty(); }
+  void reset(const IndexBox& b) {
+    box = b;
+    if (b.empty()) {
+      w0 = w1 = 0;
+      words.clear();
+      return;
+    }
+    w0 = word_of(b.lo.x);
+    w1 = word_of(b.hi.x - 1) + 1;
+    words.assign(std::size_t(w1 - w0) * std::size_t(b.hi.y - b.lo.y) * std::size_t(b.hi.z - b.lo.z), 0);
+  }
+  // Indexed by absolute word.
+  std::uint64_t* row(int y, int z) {
+    return words.data() +
+           (std::size_t(z - box.lo.z) * std::size_t(box.hi.y - box.lo.y) + std::size_t(y - box.lo.y)) *
+               std::size_t(w1 - w0) -
+           w0;
+  }
+  void add(int y, int z, int x0, int x1) {
+    x0 = std::max(x0, box.lo.x);
+    x1 = std::min(x1, box.hi.x);
+    if (x1 <= x0) return;
+    std::uint64_t* r = row(y, z);
+    const int wa = word_of(x0), wb = word_of(x1 - 1);
+    for (int w = wa; w <= wb; ++w) {
+      const int lo = w == wa ? x0 - w * kWordBits : 0;
+      const int hi = w == wb ? x1 - w * kWordBits : kWordBits;
+      r[w] |= bit_range(lo, hi);
+    }
+  }
+};
+
+// Rasterises the sweep of `pieces` along every segment into `mask` (the union), over the
+// swept bounds intersected with `clip` (empty: unclipped, finite pieces only).
+void rasterise(RowMask& mask, std::span<const ConvexPiece> pieces, std::span<const Segment> segments,
+               const geometry::Lattice& lattice, const IndexBox& clip) {
+  struct Job {
+    PieceSweep sweep;
+    IndexBox box;
+  };
+  std::vector<Job> jobs;
+  jobs.reserve(pieces.size() * segments.size());
+  IndexBox all;
+  for (const Segment& s : segments)
+    for (const ConvexPiece& p : pieces) {
+      PieceSweep sweep(p, s, lattice);
+      const IndexBox box = sweep.bounds(clip);
+      if (box.empty()) continue;
+      all = all.empty() ? box : geometry::box_union(all, box);
+      jobs.push_back({sweep, box});
+    }
+  mask.reset(all);
+  for (const Job& job : jobs)
+    for (int z = job.box.lo.z; z < job.box.hi.z; ++z)
+      for (int y = job.box.lo.y; y < job.box.hi.y; ++y) {
+        const XRange r = job.sweep.row(y, z);
+        if (!r.empty()) mask.add(y, z, r.x0, r.x1);
+      }
+}
+
+// Counts voxels and the box they span.
+struct Tally {
+  std::int64_t voxels = 0;
+  Index3 lo{INT_MAX, INT_MAX, INT_MAX}, hi{INT_MIN, INT_MIN, INT_MIN};
+
+  void add(std::uint64_t bits, int w, int y, int z) {
+    if (!bits) return;
+    voxels += std::popcount(bits);
+    const int xa = w * kWordBits + std::countr_zero(bits), xb = w * kWordBits + 63 - std::countl_zero(bits);
+    lo = {std::min(lo.x, xa), std::min(lo.y, y), std::min(lo.z, z)};
+    hi = {std::max(hi.x, xb), std::max(hi.y, y), std::max(hi.z, z)};
+  }
+  geometry::Box3 region(const geometry::Lattice& l) const {
+    if (voxels == 0) return {};
+    return l.extent({lo, {hi.x + 1, hi.y + 1, hi.z + 1}});
+  }
+};
+
+// Calls fn(y, z, w, mask_word, stock_word&) for every non-zero mask word inside the
+// stock's storage, rows in increasing (or decreasing) z.
+template <class Fn>
+void for_each_word(RowMask& mask, geometry::Solid& stock, bool z_descending, Fn&& fn) {
+  if (mask.empty()) return;
+  const IndexBox domain = stock.storage_box();
+  const IndexBox rows = geometry::box_intersection(mask.box, domain);
+  if (rows.empty()) return;
+  const int w0 = std::max(mask.w0, stock.first_word()), w1 = std::min(mask.w1, stock.first_word() + stock.words_per_row());
+  for (int i = 0; i < rows.hi.z - rows.lo.z; ++i) {
+    const int z = z_descending ? rows.hi.z - 1 - i : rows.lo.z + i;
+    for (int y = rows.lo.y; y < rows.hi.y; ++y) {
+      const std::uint64_t* m = mask.row(y, z);
+      std::uint64_t* s = stock.row(y, z).data() - stock.first_word();
+      for (int w = w0; w < w1; ++w)
+        if (m[w]) fn(y, z, w, m[w], s[w]);
+    }
+  }
+}
+
+}  // namespace
+
+std::string_view to_string(IncidentKind kind) {
+  switch (kind) {
+    case IncidentKind::RapidIntoMaterial: return "rapid into material";
+    case IncidentKind::BodyCollision: return "body collision";
+    case IncidentKind::Gouge: return "gouge";
+    case IncidentKind::UnsupportedDeposition: return "unsupported deposition";
+    case IncidentKind::DepositionOutsideDomain: return "deposition outside the domain";
+  }
+  return "?";
+}
+
+std::string describe(const Incident& i) {
+  char buf[512];
+  std::snprintf(buf, sizeof buf,
+                "line %d: %s: %.6g mm^3 (%lld voxels) in x [%.6g, %.6g] y [%.6g, %.6g] z [%.6g, %.6g], "
+                "move (%.6g, %.6g, %.6g) -> (%.6g, %.6g, %.6g)",
+                i.line, std::string(to_string(i.kind)).c_str(), i.volume, static_cast<long long>(i.voxels),
+                i.region.min.x, i.region.max.x, i.region.min.y, i.region.max.y, i.region.min.z, i.region.max.z,
+                i.from.x, i.from.y, i.from.z, i.to.x, i.to.y, i.to.z);
+  return buf;
+}
+
+MaterialSimulation::MaterialSimulation(geometry::Solid stock, std::optional<geometry::Solid> protected_region,
+                                       SimulationOptions options)
+    : stock_(std::move(stock)), protected_(std::move(protected_region)), options_(options) {
+  domain_ = stock_.storage_box();
+  if (domain_.empty()) throw std::invalid_argument("the stock must have a non-empty storage box (the simulated domain)");
+  if (protected_ && !(protected_->lattice() == stock_.lattice()))
+    throw std::invalid_argument("the protected solid must share the stock's lattice");
+  if (!(options_.arc_tolerance >= 0)) throw std::invalid_argument("arc tolerance must be >= 0");
+}
+
+double MaterialSimulation::chord_tolerance() const {
+  return options_.arc_tolerance > 0 ? options_.arc_tolerance : stock_.voxel_size() / 10;
+}
+
+MoveReport MaterialSimulation::cut(const Cutter& cutter, const MaterialMove& move) {
+  const std::vector<Segment> segments = path_segments(move, chord_tolerance());
+  const std::vector<ConvexPiece> cutting = pieces_of(cutter.cutting), body = pieces_of(cutter.body);
+  const geometry::Lattice& lattice = stock_.lattice();
+  RowMask cut_mask(scratch_[0]), body_mask(scratch_[1]);
+  rasterise(cut_mask, cutting, segments, lattice, domain_);
+  rasterise(body_mask, body, segments, lattice, domain_);
+
+  const bool rapid = move.motion == Motion::Rapid;
+  Tally removed, gouge, contact;
+  auto remove = [&] {
+    for_each_word(cut_mask, stock_, false, [&](int y, int z, int w, std::uint64_t m, std::uint64_t& s) {
+      const std::uint64_t hit = s & m;
+      if (!hit) return;
+      removed.add(hit, w, y, z);
+      if (protected_) gouge.add(hit & protected_->word_at(w, y, z), w, y, z);
+      if (rapid) contact.add(hit, w, y, z);
+      s &= ~m;
+    });
+  };
+  auto touch = [&] {
+    for_each_word(body_mask, stock_, false,
+                  [&](int y, int z, int w, std::uint64_t m, std::uint64_t& s) { contact.add(s & m, w, y, z); });
+  };
+  // The body sits above the cutting part: it reaches a voxel before the cutter does only
+  // when the move rises. On level moves a voxel on their shared boundary is cut.
+  if (!rapid && move.to.z > move.from.z) {
+    touch();
+    remove();
+  } else {
+    remove();
+    touch();
+  }
+
+  const double v = stock_.voxel_size() * stock_.voxel_size() * stock_.voxel_size();
+  MoveReport out;
+  out.removed = double(removed.voxels) * v;
+  out.gouge = double(gouge.voxels) * v;
+  auto incident = [&](IncidentKind kind, const Tally& t) {
+    if (t.voxels == 0) return;
+    out.incidents.push_back({kind, move.line, move.from, move.to, double(t.voxels) * v, t.voxels, t.region(lattice)});
+  };
+  if (rapid) {
+    out.rapid_contact = double(contact.voxels) * v;
+    incident(IncidentKind::RapidIntoMaterial, contact);
+  } else {
+    out.collision = double(contact.voxels) * v;
+    incident(IncidentKind::BodyCollision, contact);
+  }
+  incident(IncidentKind::Gouge, gouge);
+  finish(move, out);
+  return out;
+}
+
+MoveReport MaterialSimulation::deposit(const Bead& bead, const MaterialMove& move) {
+  const std::vector<Segment> segments = path_segments(move, chord_tolerance());
+  const std::vector<ConvexPiece> shape = pieces_of(bead), body = pieces_of(bead.body);
+  const geometry::Lattice& lattice = stock_.lattice();
+  const double v = stock_.voxel_size() * stock_.voxel_size() * stock_.voxel_size();
+  const bool rapid = move.motion == Motion::Rapid;
+  MoveReport out;
+  auto incident = [&](IncidentKind kind, const Tally& t) {
+    if (t.voxels == 0) return;
+    out.incidents.push_back({kind, move.line, move.from, move.to, double(t.voxels) * v, t.voxels, t.region(lattice)});
+  };
+  Tally contact;
+  auto touch = [&](RowMask& mask) {
+    for_each_word(mask, stock_, false,
+                  [&](int y, int z, int w, std::uint64_t m, std::uint64_t& s) { contact.add(s & m, w, y, z); });
+  };
+
+  if (move.process_on) {
+    RowMask bead_mask(scratch_[0]), body_mask(scratch_[1]);
+    rasterise(bead_mask, shape, segments, lattice, {});
+    rasterise(body_mask, body, segments, lattice, domain_);
+    // Bead voxels beyond the domain are lost.
+    Tally outside;
+    if (!bead_mask.empty()) {
+      const int dw0 = stock_.first_word(), dw1 = dw0 + stock_.words_per_row();
+      for (int z = bead_mask.box.lo.z; z < bead_mask.box.hi.z; ++z)
+        for (int y = bead_mask.box.lo.y; y < bead_mask.box.hi.y; ++y) {
+          const bool row_inside = y >= domain_.lo.y && y < domain_.hi.y && z >= domain_.lo.z && z < domain_.hi.z;
+          const std::uint64_t* m = bead_mask.row(y, z);
+          for (int w = bead_mask.w0; w < bead_mask.w1; ++w)
+            if (!row_inside || w < dw0 || w >= dw1) outside.add(m[w], w, y, z);
+        }
+    }
+    Tally added, overlap;
+    bool supported = false;
+    auto lay = [&] {
+      // Top rows first, so the row below still holds the material from before the move.
+      for_each_word(bead_mask, stock_, true, [&](int y, int z, int w, std::uint64_t m, std::uint64_t& s) {
+        overlap.add(s & m, w, y, z);
+        added.add(m & ~s, w, y, z);
+        if (!supported)
+          supported = (s & m) != 0 || z == domain_.lo.z || (stock_.word_at(w, y, z - 1) & m) != 0;
+        s |= m;
+      });
+    };
+    // The body sits above the bead: fresh material can reach it only on a falling move.
+    if (move.to.z < move.from.z) {
+      lay();
+      touch(body_mask);
+    } else {
+      touch(body_mask);
+      lay();
+    }
+    out.deposited = double(added.voxels) * v;
+    out.overlap = double(overlap.voxels) * v;
+    out.outside = double(outside.voxels) * v;
+    if (rapid) {
+      out.rapid_contact = double(contact.voxels) * v;
+      incident(IncidentKind::RapidIntoMaterial, contact);
+    } else {
+      out.collision = double(contact.voxels) * v;
+      incident(IncidentKind::BodyCollision, contact);
+    }
+    if (!supported) incident(IncidentKind::UnsupportedDeposition, added);
+    incident(IncidentKind::DepositionOutsideDomain, outside);
+  } else {
+    // Travel: a rapid must keep bead and body out of material, a feed move the body.
+    RowMask mask(scratch_[0]);
+    std::vector<ConvexPiece> pieces = body;
+    if (rapid) pieces.insert(pieces.end(), shape.begin(), shape.end());
+    rasterise(mask, pieces, segments, lattice, domain_);
+    touch(mask);
+    if (rapid) {
+      out.rapid_contact = double(contact.voxels) * v;
+      incident(IncidentKind::RapidIntoMaterial, contact);
+    } else {
+      out.collision = double(contact.voxels) * v;
+      incident(IncidentKind::BodyCollision, contact);
+    }
+  }
+  finish(move, out);
+  return out;
+}
+
+void MaterialSimulation::finish(const MaterialMove&, MoveReport& out) {
+  ++report_.moves;
+  report_.removed += out.removed;
+  report_.gouge += out.gouge;
+  report_.deposited += out.deposited;
+  report_.overlap += out.overlap;
+  report_.outside += out.outside;
+  report_.collision += out.collision;
+  report_.rapid_contact += out.rapid_contact;
+  report_.incidents.insert(report_.incidents.end(), out.incidents.begin(), out.incidents.end());
+}
+
+}  // namespace hybridctl::sim

@@ -1,0 +1,106 @@
+#pragma once
+// Material simulation: replays moves into a voxel stock and reports what happened.
+//
+// A cutter removes every voxel its cutting part sweeps (sim/sweep.hpp: exact at voxel
+// resolution); its body (shank, holder) must touch no material. A bead adds every voxel
+// it sweeps while the process is on. Programmed points: the cutter's tip, the bead's
+// bottom (sim/instrument.hpp). docs/simulation.md describes conventions and incidents.
+//
+//   sim::MaterialSimulation sim(stock, design_grown_by_tolerance);
+//   sim.cut(sim::cutter_of(tool), {sim::Motion::Linear, {0, 0, 5}, {20, 0, 5}, {}, false, 42});
+//   if (!sim.report().clean()) ... sim.report().incidents ...
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "geometry/solid.hpp"
+#include "sim/instrument.hpp"
+#include "sim/moves.hpp"
+
+namespace hybridctl::sim {
+
+struct SimulationOptions {
+  // Largest distance (mm) between an arc and the chords it is simulated with; 0 means a
+  // tenth of the voxel size.
+  double arc_tolerance = 0;
+};
+
+enum class IncidentKind {
+  RapidIntoMaterial,        // a rapid touched material (cutter or body; bead or nozzle)
+  BodyCollision,            // a feed move touched material with the non-cutting body
+  Gouge,                    // a move removed voxels of the protected solid
+  UnsupportedDeposition,    // a bead touched no material and rested on nothing
+  DepositionOutsideDomain,  // a bead reached beyond the simulated domain: that part is lost
+};
+std::string_view to_string(IncidentKind kind);
+
+struct Incident {
+  IncidentKind kind = IncidentKind::RapidIntoMaterial;
+  int line = 0;           // the move's line
+  Vec3 from, to;          // the move's programmed points
+  double volume = 0;      // mm^3 of the offending voxels
+  std::int64_t voxels = 0;
+  geometry::Box3 region;  // mm extent of the offending voxels
+};
+// One line of text, e.g. "line 12: rapid into material: 3.5 mm^3 in x [1, 2] y [...] z [...]".
+std::string describe(const Incident& incident);
+
+// What one move did, mm^3.
+struct MoveReport {
+  double removed = 0;        // material removed
+  double gouge = 0;          // of which inside the protected solid
+  double deposited = 0;      // material added (voxels that were empty)
+  double overlap = 0;        // bead voxels that were already material
+  double outside = 0;        // bead voxels beyond the domain (lost)
+  double collision = 0;      // material touched by the body during a feed move
+  double rapid_contact = 0;  // material touched during a rapid
+  std::vector<Incident> incidents;
+};
+
+// Totals over all moves so far, mm^3, and every incident in move order.
+struct SimulationReport {
+  std::int64_t moves = 0;
+  double removed = 0, gouge = 0, deposited = 0, overlap = 0, outside = 0, collision = 0, rapid_contact = 0;
+  std::vector<Incident> incidents;
+  bool clean() const { return incidents.empty(); }
+};
+
+class MaterialSimulation {
+ public:
+  // `stock`: the material at the start. Its storage box is the simulated domain: nothing
+  // exists beyond it, deposition beyond it is lost (and reported), and its lowest voxel
+  // layer stands on the build plate. `protected_region`: voxels that must not be removed
+  // (the design grown by its tolerance), on the stock's lattice (std::invalid_argument
+  // otherwise).
+  explicit MaterialSimulation(geometry::Solid stock, std::optional<geometry::Solid> protected_region = std::nullopt,
+                              SimulationOptions options = {});
+
+  // Moves the cutter: removes what its cutting part sweeps, checks its body. A rapid
+  // also cuts (the spindle turns) and reports all material the cutter or body touched.
+  MoveReport cut(const Cutter& cutter, const MaterialMove& move);
+  // Moves the head: with the process on, adds what the bead sweeps; otherwise a rapid
+  // reports the material its bead or body would touch, a feed move what its body touches.
+  MoveReport deposit(const Bead& bead, const MaterialMove& move);
+
+  const geometry::Solid& stock() const { return stock_; }
+  const std::optional<geometry::Solid>& protected_region() const { return protected_; }
+  const SimulationReport& report() const { return report_; }
+  const SimulationOptions& options() const { return options_; }
+
+ private:
+  double chord_tolerance() const;
+  void finish(const MaterialMove& move, MoveReport& out);
+
+  geometry::Solid stock_;
+  std::optional<geometry::Solid> protected_;
+  SimulationOptions options_;
+  geometry::IndexBox domain_;
+  SimulationReport report_;
+  // Reused scratch words for one move's swept voxels (instrument, body).
+  std::vector<std::uint64_t> scratch_[2];
+};
+
+}  // namespace hybridctl::sim
