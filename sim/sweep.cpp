@@ -228,7 +228,7 @@ XRange PieceSweep::row(int y, int z) const {
       }
       // A ramp: the radius varies along the sub-segment. Voxels between the sweeps of
       // the smallest and the largest radius are decided one by one; the row's interval
-      // is convex, so scanning stops at the first voxel inside from each end.
+      // is convex, so each band needs only a binary search for its boundary voxel.
       const XRange out_v = to_voxels(outer.lo, outer.hi);
       if (out_v.empty()) return {};
       const Interval inner = capsule_row(flat(s0), flat(s1), std::min(radius_at(za), radius_at(zb)), yc, 0);
@@ -236,13 +236,29 @@ XRange PieceSweep::row(int y, int z) const {
       in_v.x0 = std::max(in_v.x0, out_v.x0);
       in_v.x1 = std::min(in_v.x1, out_v.x1);
       auto inside = [&](int x) { return torus_contains(origin_.x + (x + 0.5) * h_, yc, zc, ta, tb); };
-      int first = out_v.x0;
-      const int left_stop = in_v.empty() ? out_v.x1 : in_v.x0;
-      while (first < left_stop && !inside(first)) ++first;
-      if (first == out_v.x1) return {};
-      int last = out_v.x1 - 1;
-      const int right_stop = in_v.empty() ? first : in_v.x1 - 1;
-      while (last > right_stop && !inside(last)) --last;
+      int first, last;
+      if (in_v.empty()) {
+        first = out_v.x0;
+        while (first < out_v.x1 && !inside(first)) ++first;
+        if (first == out_v.x1) return {};
+        last = out_v.x1 - 1;
+        while (last > first && !inside(last)) --last;
+      } else {
+        // Inside is monotone across each band: binary search for the boundary voxel.
+        int lo = out_v.x0, hi = in_v.x0;  // the answer is in [lo, hi]; hi is inside
+        while (lo < hi) {
+          const int mid = lo + (hi - lo) / 2;
+          if (inside(mid)) hi = mid; else lo = mid + 1;
+        }
+        first = lo;
+        lo = in_v.x1 - 1;
+        hi = out_v.x1 - 1;  // the answer is in [lo, hi]; lo is inside
+        while (lo < hi) {
+          const int mid = hi - (hi - lo) / 2;
+          if (inside(mid)) lo = mid; else hi = mid - 1;
+        }
+        last = lo;
+      }
       return {first, last + 1};
     }
   }
@@ -275,14 +291,26 @@ bool PieceSweep::torus_contains(double x, double y, double z, double ta, double 
   eval(tb, f_hi, df_hi);
   if (f_hi <= limit) return true;
   if (df_hi <= 0) return false;
+  // Bisection on the sign of F'. The tangents at both ends bound F from below; once
+  // that bound clears the limit, the point is outside.
   double lo = ta, hi = tb;
   for (int i = 0; i < 200; ++i) {
+    const double cross = (f_hi - f_lo + df_lo * lo - df_hi * hi) / (df_lo - df_hi);
+    if (f_lo + df_lo * (cross - lo) > limit) return false;
     const double mid = 0.5 * (lo + hi);
     if (mid <= lo || mid >= hi) break;
     double f, df;
     eval(mid, f, df);
     if (f <= limit) return true;
-    (df > 0 ? hi : lo) = mid;
+    if (df > 0) {
+      hi = mid;
+      f_hi = f;
+      df_hi = df;
+    } else {
+      lo = mid;
+      f_lo = f;
+      df_lo = df;
+    }
   }
   return false;
 }
