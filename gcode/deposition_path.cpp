@@ -295,6 +295,10 @@ Toolpath deposition_path(const Solid& roi_part, const Solid& existing_part, cons
     } else {
       const double lift =
           std::min(safe_z, std::max({at.z, z, corridor_top({at.x, at.y}, p)}) + travel);
+      // Out of a surface the bead was laid into, at feed; then rapid.
+      const auto [ax, ay] = column_of({at.x, at.y});
+      const double here = std::max(existing_top.at(ax, ay), deposited_top.at(ax, ay));
+      if (at.z < here) move(MoveKind::Feed, {at.x, at.y, here}, head.feed, false, "out of the surface below");
       if (at.z < lift) move(MoveKind::Rapid, {at.x, at.y, lift}, 0, false);
       move(MoveKind::Rapid, {p.x, p.y, std::max(lift, at.z)}, 0, false);
     }
@@ -391,7 +395,12 @@ Toolpath deposition_path(const Solid& roi_part, const Solid& existing_part, cons
         if (region.at(x, y)) deposited_top.ref(x, y) = std::max(deposited_top.at(x, y), zb + lh);
   }
 
-  if (started) move(MoveKind::Rapid, {at.x, at.y, safe_z}, 0, false, "clear of the part");
+  if (started) {
+    const auto [ax, ay] = column_of({at.x, at.y});
+    const double here = std::max(existing_top.at(ax, ay), deposited_top.at(ax, ay));
+    if (at.z < here) move(MoveKind::Feed, {at.x, at.y, here}, head.feed, false, "out of the surface below");
+    move(MoveKind::Rapid, {at.x, at.y, safe_z}, 0, false, "clear of the part");
+  }
   if (warnings_overhang > kMaxWarningsPerKind)
     path.warnings.push_back("overhang: " + std::to_string(warnings_overhang) + " layers in all, " +
                             mm(overhang_area_total) + " mm^2 of deposit with nothing below it");

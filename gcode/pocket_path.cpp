@@ -6,6 +6,7 @@
 #include <limits>
 #include <numbers>
 #include <optional>
+#include <map>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -302,43 +303,47 @@ std::vector<CellPath> chain_paths(const SliceMask& cells, const SliceMask& regio
   return out;
 }
 
-// Greedy order: from `from`, the nearest path end next (paths may run backwards; a
-// closed path starts at its nearest point).
-std::vector<CellPath> order_paths(std::vector<CellPath> paths, Cell from) {
-  std::vector<CellPath> out;
-  std::vector<bool> used(paths.size(), false);
-  for (std::size_t n = 0; n < paths.size(); ++n) {
-    std::size_t best = 0;
-    int best_d = std::numeric_limits<int>::max(), best_mode = 0;
-    std::size_t best_at = 0;
-    for (std::size_t i = 0; i < paths.size(); ++i) {
-      if (used[i]) continue;
-      const CellPath& p = paths[i];
-      if (p.closed) {
-        for (std::size_t j = 0; j + 1 < p.points.size(); ++j) {
-          const int d = manhattan(from, p.points[j]);
-          if (d < best_d) best_d = d, best = i, best_mode = 2, best_at = j;
-        }
-      } else {
-        const int d0 = manhattan(from, p.points.front()), d1 = manhattan(from, p.points.back());
-        if (d0 < best_d) best_d = d0, best = i, best_mode = 0;
-        if (d1 < best_d) best_d = d1, best = i, best_mode = 1;
-      }
+// A way to start one of the paths still to cut: from its front (mode 0), from its back
+// (mode 1, the path runs backwards), or for a closed path from its waypoint `at` (mode 2).
+struct Candidate {
+  std::size_t path = 0;
+  int mode = 0;
+  std::size_t at = 0;
+  int distance = 0;
+};
+
+// Every way to start a path, nearest to `from` first.
+std::vector<Candidate> candidates(const std::vector<CellPath>& todo, Cell from) {
+  std::vector<Candidate> out;
+  for (std::size_t i = 0; i < todo.size(); ++i) {
+    const CellPath& p = todo[i];
+    if (p.closed) {
+      for (std::size_t j = 0; j + 1 < p.points.size(); ++j) out.push_back({i, 2, j, manhattan(from, p.points[j])});
+    } else {
+      out.push_back({i, 0, 0, manhattan(from, p.points.front())});
+      if (p.points.size() > 1) out.push_back({i, 1, 0, manhattan(from, p.points.back())});
     }
-    used[best] = true;
-    CellPath p = std::move(paths[best]);
-    if (best_mode == 1) std::reverse(p.points.begin(), p.points.end());
-    if (best_mode == 2 && best_at > 0) {
-      std::vector<Cell> loop(p.points.begin(), p.points.end() - 1);
-      std::rotate(loop.begin(), loop.begin() + std::ptrdiff_t(best_at), loop.end());
-      loop.push_back(loop.front());
-      p.points = simplify(loop);
-    }
-    from = p.points.back();
-    out.push_back(std::move(p));
   }
+  std::stable_sort(out.begin(), out.end(), [](const Candidate& a, const Candidate& b) { return a.distance < b.distance; });
   return out;
 }
+
+CellPath oriented(const CellPath& path, const Candidate& c) {
+  CellPath p = path;
+  if (c.mode == 1) std::reverse(p.points.begin(), p.points.end());
+  if (c.mode == 2 && c.at > 0) {
+    std::vector<Cell> loop(p.points.begin(), p.points.end() - 1);
+    std::rotate(loop.begin(), loop.begin() + std::ptrdiff_t(c.at), loop.end());
+    loop.push_back(loop.front());
+    p.points = simplify(loop);
+  }
+  return p;
+}
+
+// How many of the nearest starts are tried for a feed link, and for an entry from air,
+// before retracting or ramping.
+constexpr std::size_t kLinkCandidates = 8;
+constexpr std::size_t kEntryCandidates = 12;
 
 // ---------------------------------------------------------------------------------------
 
@@ -369,6 +374,14 @@ class PocketBuilder {
   void move(MoveKind kind, Vec3 to, double feed, bool cutting, std::string comment = {});
   void retract();
   bool enter(const CellPath& p, int k, const SliceMask& usable);
+  // Where the tool can come straight down in air and reach the start of `p` at level k:
+  // the start itself, or a cell before it on the line of its first leg (a lead-in).
+  std::optional<Cell> air_entry(const CellPath& p, int k, const SliceMask& usable);
+  bool in_air(Cell c, int k);
+  void cut_paths(std::vector<CellPath> todo, int k, const SliceMask& usable);
+  Cell current_cell() const {
+    return {int(std::floor((at_.x - lattice_.origin.x) / h_)), int(std::floor((at_.y - lattice_.origin.y) / h_))};
+  }
   void stamp_run(int k);
 
   config::CuttingTool tool_;
@@ -388,6 +401,7 @@ class PocketBuilder {
   bool at_level_ = false;
   std::vector<Cell> run_cells_;
   std::string pending_comment_;
+  std::map<std::pair<int, int>, bool> air_cache_;  // per level, until the next removal
   int plunges_into_material_ = 0, skipped_entries_ = 0;
 };
 
@@ -443,6 +457,7 @@ void PocketBuilder::stamp_run(int k) {
   Solid tips(lattice_, {{x0, y0, k}, {x1 + 1, y1 + 1, k + 1}});
   for (const Cell& c : run_cells_) tips.set({c.x, c.y, k});
   run_cells_.clear();
+  air_cache_.clear();
   const int R = int(std::ceil(model_.cutter_radius / h_)) + 1;
   const IndexBox rb = remaining_.bounding_box();
   const IndexBox reach{{x0 - R, y0 - R, k}, {x1 + 1 + R, y1 + 1 + R, std::max(k + 1, rb.hi.z)}};
@@ -468,6 +483,84 @@ void PocketBuilder::retract() {
   at_level_ = false;
 }
 
+bool PocketBuilder::in_air(Cell c, int k) {
+  const auto key = std::pair<int, int>{c.x, c.y};
+  if (const auto it = air_cache_.find(key); it != air_cache_.end()) return it->second;
+  const bool air = contact_height(c, Part::Whole) < centre_z(k) - kHeightSlack;
+  air_cache_[key] = air;
+  return air;
+}
+
+std::optional<Cell> PocketBuilder::air_entry(const CellPath& p, int k, const SliceMask& usable) {
+  const Cell b = p.points.front();
+  if (in_air(b, k)) return b;
+  std::vector<Cell> dirs;
+  if (p.points.size() >= 2) {
+    const Cell d = unit_towards(p.points[0], p.points[1]);
+    dirs.push_back({-d.x, -d.y});
+  } else {
+    dirs = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
+  }
+  // Far enough to get the cutter clear of the material at the start.
+  const int lead_max = int(std::ceil(model_.cutter_radius / h_)) + 3;
+  for (const Cell d : dirs)
+    for (int i = 1; i <= lead_max; ++i) {
+      const Cell a{b.x + i * d.x, b.y + i * d.y};
+      if (!usable.at(a)) break;
+      if (in_air(a, k)) return a;
+    }
+  return std::nullopt;
+}
+
+void PocketBuilder::cut_paths(std::vector<CellPath> todo, int k, const SliceMask& usable) {
+  const double zk = centre_z(k);
+  auto take = [&](const Candidate& c) {
+    CellPath p = oriented(todo[c.path], c);
+    todo[c.path] = std::move(todo.back());
+    todo.pop_back();
+    return p;
+  };
+  auto cut_along = [&](const CellPath& p) {
+    for (std::size_t i = 1; i < p.points.size(); ++i) {
+      for_leg_cells(p.points[i - 1], p.points[i], [&](Cell v) { run_cells_.push_back(v); });
+      move(MoveKind::Feed, at_cell(p.points[i], zk), tool_.feed, true);
+    }
+  };
+  while (!todo.empty()) {
+    const Cell cur = started_ ? current_cell() : todo.front().points.front();
+    const std::vector<Candidate> cands = candidates(todo, cur);
+    if (at_level_) {
+      // Feed over to the nearest start that a link inside the usable region reaches.
+      bool linked = false;
+      for (std::size_t i = 0; i < cands.size() && i < kLinkCandidates && !linked; ++i) {
+        const CellPath probe = oriented(todo[cands[i].path], cands[i]);
+        if (const auto link = link_cells(cur, probe.points.front(), usable)) {
+          const CellPath p = take(cands[i]);
+          Cell prev = cur;
+          for (const Cell& c : *link) {
+            for_leg_cells(prev, c, [&](Cell v) { run_cells_.push_back(v); });
+            move(MoveKind::Feed, at_cell(c, zk), tool_.feed, true);
+            prev = c;
+          }
+          cut_along(p);
+          linked = true;
+        }
+      }
+      if (linked) continue;
+      retract();
+    }
+    // Enter at the nearest start reachable from air, else at the nearest.
+    std::size_t pick = 0;
+    for (std::size_t i = 0; i < cands.size() && i < kEntryCandidates; ++i)
+      if (air_entry(oriented(todo[cands[i].path], cands[i]), k, usable)) {
+        pick = i;
+        break;
+      }
+    const CellPath p = take(cands[pick]);
+    if (enter(p, k, usable)) cut_along(p);
+  }
+}
+
 // Gets the tool to the start of `p` at level k from safe_z: a plunge where the way down
 // is in air, else a lead-in from air along the first leg, else a ramp along it.
 bool PocketBuilder::enter(const CellPath& p, int k, const SliceMask& usable) {
@@ -490,39 +583,16 @@ bool PocketBuilder::enter(const CellPath& p, int k, const SliceMask& usable) {
     move(MoveKind::Rapid, at_cell(c, std::min(safe_z_, stop)), 0, false);
   };
 
-  // 1. Air all the way down: plunge.
-  const double need_b = contact_height(b, Part::Whole);
-  if (need_b < zk - kHeightSlack) {
-    go_above(b, std::max(need_b, zk) + options_.retract_clearance);
-    move(MoveKind::Feed, at_cell(b, zk), tool_.plunge_feed, false, "plunge in air");
+  // 1. Air all the way down, at the start or on the line before it: plunge there (and
+  // lead in).
+  if (const std::optional<Cell> a = air_entry(p, k, usable)) {
+    go_above(*a, std::max(contact_height(*a, Part::Whole), zk) + options_.retract_clearance);
+    move(MoveKind::Feed, at_cell(*a, zk), tool_.plunge_feed, false, "plunge in air");
     at_level_ = true;
-    run_cells_.push_back(b);
+    for_leg_cells(*a, b, [&](Cell c) { run_cells_.push_back(c); });
+    if (!(*a == b)) move(MoveKind::Feed, at_cell(b, zk), tool_.feed, true, "lead-in");
     return true;
   }
-
-  // 2. Lead in from air along the row the path starts on.
-  std::vector<Cell> dirs;
-  if (p.points.size() >= 2) {
-    const Cell d = unit_towards(p.points[0], p.points[1]);
-    dirs.push_back({-d.x, -d.y});
-  } else {
-    dirs = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
-  }
-  const int lead_max = int(std::ceil(model_.cutter_radius / h_)) + 3;
-  for (const Cell d : dirs)
-    for (int i = 1; i <= lead_max; ++i) {
-      const Cell a{b.x + i * d.x, b.y + i * d.y};
-      if (!usable.at(a)) break;
-      const double need_a = contact_height(a, Part::Whole);
-      if (need_a < zk - kHeightSlack) {
-        go_above(a, std::max(need_a, zk) + options_.retract_clearance);
-        move(MoveKind::Feed, at_cell(a, zk), tool_.plunge_feed, false, "plunge in air");
-        at_level_ = true;
-        for_leg_cells(a, b, [&](Cell c) { run_cells_.push_back(c); });
-        move(MoveKind::Feed, at_cell(b, zk), tool_.feed, true, "lead-in");
-        return true;
-      }
-    }
 
   // 3. Ramp down along the first leg (or the longest free row from the start).
   if (contact_height(b, Part::Body) >= zk - kHeightSlack) {
@@ -664,18 +734,15 @@ Toolpath& PocketBuilder::run(const Solid& roi, const Solid& keep, const Solid& s
     if (useful.empty()) continue;
     ++level_number;
 
-    std::vector<CellPath> paths;
-    Cell from{int(std::floor((at_.x - lattice_.origin.x) / h_)), int(std::floor((at_.y - lattice_.origin.y) / h_))};
-    if (!started_) from = {cell_bounds(useful).x0, cell_bounds(useful).y0};
+    air_cache_.clear();
+    pending_comment_ = "level " + std::to_string(level_number) + " z=" + mm(centre_z(k));
     if (options_.strategy == PocketStrategy::Zigzag) {
       const bool along_x = options_.raster == PocketRaster::AlongX || (alternate && level_number % 2 == 1);
-      paths = order_paths(zigzag_rows(useful, along_x, over), from);
-      if (options_.wall_pass == WallPass::Contour && !paths.empty()) {
-        std::vector<CellPath> walls = order_paths(chain_paths(boundary_cells(useful), useful, usable), paths.back().points.back());
-        paths.insert(paths.end(), walls.begin(), walls.end());
-      }
+      cut_paths(zigzag_rows(useful, along_x, over), k, usable);
+      if (options_.wall_pass == WallPass::Contour) cut_paths(chain_paths(boundary_cells(useful), useful, usable), k, usable);
     } else {
-      // Rings close enough that every cell between two is within the cutter's reach.
+      // Rings close enough that every cell between two is within the cutter's reach,
+      // cut from the innermost out.
       const double ring = std::clamp(std::min(step_over, model_.cutter_radius - 1.5 * h_), h_, std::max(step_over, h_));
       std::vector<std::vector<CellPath>> rings;
       for (int i = 0;; ++i) {
@@ -683,37 +750,7 @@ Toolpath& PocketBuilder::run(const Solid& roi, const Solid& keep, const Solid& s
         if (inner.empty()) break;
         rings.push_back(chain_paths(boundary_cells(inner), inner, usable));
       }
-      for (auto it = rings.rbegin(); it != rings.rend(); ++it) {
-        std::vector<CellPath> ordered = order_paths(*it, from);
-        if (!ordered.empty()) from = ordered.back().points.back();
-        paths.insert(paths.end(), ordered.begin(), ordered.end());
-      }
-    }
-
-    pending_comment_ = "level " + std::to_string(level_number) + " z=" + mm(centre_z(k));
-    const double zk = centre_z(k);
-    for (const CellPath& p : paths) {
-      const Cell b = p.points.front();
-      bool linked = false;
-      if (at_level_) {
-        const Cell a{int(std::floor((at_.x - lattice_.origin.x) / h_)), int(std::floor((at_.y - lattice_.origin.y) / h_))};
-        if (const auto link = link_cells(a, b, usable)) {
-          Cell prev = a;
-          for (const Cell& c : *link) {
-            for_leg_cells(prev, c, [&](Cell v) { run_cells_.push_back(v); });
-            move(MoveKind::Feed, at_cell(c, zk), tool_.feed, true);
-            prev = c;
-          }
-          linked = true;
-        } else {
-          retract();
-        }
-      }
-      if (!linked && !enter(p, k, usable)) continue;
-      for (std::size_t i = 1; i < p.points.size(); ++i) {
-        for_leg_cells(p.points[i - 1], p.points[i], [&](Cell v) { run_cells_.push_back(v); });
-        move(MoveKind::Feed, at_cell(p.points[i], zk), tool_.feed, true);
-      }
+      for (auto it = rings.rbegin(); it != rings.rend(); ++it) cut_paths(*it, k, usable);
     }
     retract();
   }

@@ -30,8 +30,7 @@ Vec3 turn(Vec3 p, QuarterTurn t) {
 
 QuarterTurn inverse(QuarterTurn t) { return {t.axis, (4 - ((t.quarter_turns % 4) + 4) % 4) % 4}; }
 
-// The voxel whose centre is the turned centre of v; throws when the lattice origin is
-// not on the half-voxel grid (the turned centre is then no voxel centre).
+// The voxel whose centre is the turned centre of v; throws when that is no voxel centre.
 Index3 turn_index(Index3 v, const Lattice& lattice, QuarterTurn t) {
   const Vec3 c = turn(lattice.center(v), t);
   const double h = lattice.voxel_size;
@@ -41,8 +40,8 @@ Index3 turn_index(Index3 v, const Lattice& lattice, QuarterTurn t) {
     if (std::abs(f - r) > 1e-6) {
       throw std::invalid_argument("setup frame: the lattice origin (" + std::to_string(lattice.origin.x) + ", " +
                                   std::to_string(lattice.origin.y) + ", " + std::to_string(lattice.origin.z) +
-                                  ") mm is not on the half-voxel grid, so quarter turns about the part origin "
-                                  "do not map voxels onto voxels");
+                                  ") mm does not let this quarter turn about the part origin map voxel centres "
+                                  "onto voxel centres");
     }
     return int(r);
   };
@@ -62,7 +61,7 @@ Solid turn_solid(const Solid& s, QuarterTurn t) {
   if (turns == 0) return s;
   const Lattice& lattice = s.lattice();
   // rotate_quarter_turns turns about the lattice origin o; about the part origin the
-  // image is moved by R o - o, a whole number of voxels when o is on the half-voxel grid.
+  // image is moved by R o - o.
   Solid turned = geometry::rotate_quarter_turns(s, t.axis, turns);
   const Vec3 o = lattice.origin;
   if (o.x == 0 && o.y == 0 && o.z == 0) return turned;
@@ -72,7 +71,7 @@ Solid turn_solid(const Solid& s, QuarterTurn t) {
   auto whole = [&](double mm) {
     const double f = mm / h;
     if (std::abs(f - std::round(f)) > 1e-6)
-      throw std::invalid_argument("setup frame: the lattice origin is not on the half-voxel grid");
+      throw std::invalid_argument("setup frame: the lattice origin does not let this quarter turn map voxels onto voxels");
     return int(std::round(f));
   };
   return geometry::translate(turned, {whole(shift.x), whole(shift.y), whole(shift.z)});

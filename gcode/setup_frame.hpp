@@ -13,9 +13,10 @@
 //   +Y         1 quarter turn  about X  ( x, -z,  y)
 //   -Y         3 quarter turns about X  ( x,  z, -y)
 //
-// Quarter turns map a lattice whose origin lies on the half-voxel grid onto itself, so
-// solids turn exactly (geometry::rotate_quarter_turns); a lattice whose origin does not
-// is rejected with std::invalid_argument.
+// Solids turn exactly (geometry::rotate_quarter_turns) when the turn maps voxel centres
+// onto voxel centres, as it does when the lattice origin's coordinates are whole
+// multiples of the voxel size (the planner's lattices start at (0, 0, 0)); otherwise the
+// functions throw std::invalid_argument.
 
 #include "config/machine.hpp"
 #include "geometry/solid.hpp"
