@@ -71,11 +71,11 @@ double arc_sweep(const Motion& m) {
   return sweep;
 }
 
-void motion_bounds(const Motion& m, Vec3& lo, Vec3& hi) {
-  lo = {std::min(m.from_machine.x, m.to_machine.x), std::min(m.from_machine.y, m.to_machine.y),
-        std::min(m.from_machine.z, m.to_machine.z)};
-  hi = {std::max(m.from_machine.x, m.to_machine.x), std::max(m.from_machine.y, m.to_machine.y),
-        std::max(m.from_machine.z, m.to_machine.z)};
+namespace {
+
+/// The box of the points a motion reaches: its end point and, for arcs, the circle's
+/// extreme points within the sweep. `lo`/`hi` come in holding the points so far.
+void add_reach(const Motion& m, Vec3& lo, Vec3& hi) {
   if (!m.is_arc()) return;
   const PlaneAxes pa = plane_axes(m.plane);
   const double cx = get(m.centre_machine, pa.first), cy = get(m.centre_machine, pa.second);
@@ -98,9 +98,21 @@ void motion_bounds(const Motion& m, Vec3& lo, Vec3& hi) {
   }
 }
 
+}  // namespace
+
+void motion_bounds(const Motion& m, Vec3& lo, Vec3& hi) {
+  lo = {std::min(m.from_machine.x, m.to_machine.x), std::min(m.from_machine.y, m.to_machine.y),
+        std::min(m.from_machine.z, m.to_machine.z)};
+  hi = {std::max(m.from_machine.x, m.to_machine.x), std::max(m.from_machine.y, m.to_machine.y),
+        std::max(m.from_machine.z, m.to_machine.z)};
+  add_reach(m, lo, hi);
+}
+
 std::optional<std::string> envelope_violation(const Motion& m, const config::Envelope& envelope, double tolerance) {
-  Vec3 lo, hi;
-  motion_bounds(m, lo, hi);
+  // The start is the previous motion's end, checked with it: only what this motion
+  // reaches is reported here.
+  Vec3 lo = m.to_machine, hi = m.to_machine;
+  add_reach(m, lo, hi);
   std::string out;
   const char names[3] = {'X', 'Y', 'Z'};
   for (int axis = 0; axis < 3; ++axis) {
@@ -124,12 +136,10 @@ std::optional<std::string> envelope_violation(const Motion& m, const config::Env
                " but the machine has no " + name + " axis";
       continue;
     }
-    for (double v : {positions.first, positions.second})
-      if (v < axis->range.min - tolerance || v > axis->range.max + tolerance) {
-        out += std::string(out.empty() ? "" : "; ") + name + " reaches " + fmt(v) + " deg, outside the " + name +
-               " range [" + fmt(axis->range.min) + ", " + fmt(axis->range.max) + "]";
-        break;
-      }
+    const double v = positions.second;
+    if (v < axis->range.min - tolerance || v > axis->range.max + tolerance)
+      out += std::string(out.empty() ? "" : "; ") + name + " reaches " + fmt(v) + " deg, outside the " + name +
+             " range [" + fmt(axis->range.min) + ", " + fmt(axis->range.max) + "]";
   }
   if (out.empty()) return std::nullopt;
   return out;

@@ -86,8 +86,9 @@ CheckReport check_program(std::string_view text, const config::Machine& machine,
 /// points of the circle within the swept angle.
 void motion_bounds(const Motion& m, Vec3& lo, Vec3& hi);
 
-/// What of a motion lies outside the envelope, as text ("X 412.5 is beyond the X travel
-/// [0, 400]"), or nothing when it stays inside (within `tolerance`).
+/// What a motion reaches outside the envelope, as text ("X reaches 412.5, beyond the X
+/// travel [0, 400]"), or nothing when it stays inside (within `tolerance`). What it reaches
+/// is its end point and an arc's extreme points; its start is the previous motion's end.
 std::optional<std::string> envelope_violation(const Motion& m, const config::Envelope& envelope,
                                               double tolerance = 1e-6);
 

@@ -435,7 +435,9 @@ void Interpreter::run(const Block& b, ModalState& s) {
       fail(b, machine_coords.column, "found G53 in incremental mode (G91); expected G90 for moves in machine "
                                      "coordinates");
   }
-  if (axis_words != 0) {
+  // LinuxCNC runs a G2/G3 with centre offsets and no axis words as a full circle.
+  const bool arc_mode = s.motion_active && (s.motion == MotionKind::ArcCw || s.motion == MotionKind::ArcCcw);
+  if (axis_words != 0 || (arc_mode && (b.letters & kArcLetters) != 0)) {
     if (!s.motion_active)
       fail(b, first_axis_column, "found axis words with no motion mode in effect; expected G0, G1, G2 or G3 on "
                                  "this or an earlier line");

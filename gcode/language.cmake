@@ -6,6 +6,8 @@ add_library(hybridctl_gcode STATIC
   ${CMAKE_CURRENT_LIST_DIR}/interpreter.cpp
   ${CMAKE_CURRENT_LIST_DIR}/check.cpp
   ${CMAKE_CURRENT_LIST_DIR}/files.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/post.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/tool_table.cpp
 )
 target_include_directories(hybridctl_gcode PUBLIC ${PROJECT_SOURCE_DIR})
 target_link_libraries(hybridctl_gcode
