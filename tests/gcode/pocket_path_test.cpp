@@ -149,10 +149,10 @@ std::set<long> feed_levels(const Toolpath& p) {
 
 double centre_z(int k) { return kLattice.origin.z + (k + 0.5) * kLattice.voxel_size; }
 
-// A block with a closed rectangular pocket, 12 x 8 mm, 5 mm deep.
+// A block with a closed rectangular pocket, 16 x 14 mm, 5 mm deep.
 struct ClosedPocket {
-  Solid stock = box({{0, 0, 0}, {20, 16, 8}});
-  Solid roi = box({{4, 4, 3}, {16, 12, 8}});
+  Solid stock = box({{0, 0, 0}, {24, 22, 8}});
+  Solid roi = box({{4, 4, 3}, {20, 18, 8}});
   Solid keep = geometry::subtract(stock, roi);
 };
 
@@ -202,6 +202,35 @@ TEST(PocketPath, ClosedPocketIsClearedWithoutGougingAndEnteredByRamps) {
   EXPECT_EQ(unreachable.voxel_count(), 4 * 10 * 8) << "only the corners are out of reach";
   // The floor is cut at the ROI's bottom voxel layer.
   EXPECT_TRUE(feed_levels(p).count(std::lround(centre_z(6) * 1000)));
+}
+
+TEST(PocketPath, ZigzagRowsAreAtMostAStepOverApart) {
+  const Solid stock = box({{0, 0, 0}, {30, 30, 4}});
+  const Solid roi = box({{3, 3, 2}, {27, 27, 4}});
+  const Solid keep = geometry::subtract(stock, roi);
+  const auto tool = flat_4mm();
+  PocketOptions o;
+  o.wall_pass = WallPass::None;
+  const Toolpath p = pocket_path(roi, keep, stock, tool, top_setup(), o);
+  const auto starts = move_starts(p);
+  std::set<long> rows;  // y (um) of cuts along X
+  for (std::size_t i = 0; i < p.moves.size(); ++i) {
+    const auto& m = p.moves[i];
+    if (m.kind == MoveKind::Feed && m.process_on && m.to.z == starts[i].z && m.to.y == starts[i].y &&
+        std::abs(m.to.x - starts[i].x) > tool.diameter)
+      rows.insert(std::lround(m.to.y * 1000));
+  }
+  ASSERT_GE(rows.size(), 8u);
+  // From the first row at the edge of the tool's reach (2 mm off the wall, on a voxel
+  // centre) to the last, no two neighbours more than step_over apart.
+  EXPECT_EQ(*rows.begin(), 5250);
+  EXPECT_EQ(*rows.rbegin(), 24750);
+  for (auto it = std::next(rows.begin()); it != rows.end(); ++it)
+    EXPECT_LE(*it - *std::prev(it), std::lround(tool.step_over * 1000)) << "rows at " << *std::prev(it) << " and " << *it;
+  // Rows alone clear the floor away from the walls.
+  const Replay r = replay(p, stock, keep, tool);
+  EXPECT_EQ(r.gouges, 0);
+  EXPECT_EQ(geometry::intersect(r.present, box({{5, 5, 2}, {25, 25, 4}})).voxel_count(), 0);
 }
 
 TEST(PocketPath, OpenPocketsArePlungedInAirAndLedIn) {
