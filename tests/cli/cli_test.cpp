@@ -69,7 +69,8 @@ const std::string kBracket = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/part
 
 TEST_F(Cli, EverySubcommandHasHelp) {
   for (auto args : std::vector<std::vector<std::string>>{
-           {"--help"}, {"machine", "--help"}, {"machine", "check", "--help"}, {"voxelize", "--help"}, {"inspect", "--help"}, {"plan", "--help"}}) {
+           {"--help"}, {"machine", "--help"}, {"machine", "check", "--help"}, {"voxelize", "--help"}, {"inspect", "--help"}, {"plan", "--help"},
+           {"gcode", "--help"}, {"gcode", "check", "--help"}}) {
     const Outcome r = run(args);
     EXPECT_EQ(r.exit_code, 0) << args[0];
     EXPECT_NE(r.out.find("Usage"), std::string::npos) << r.out;
@@ -231,6 +232,45 @@ TEST_F(Cli, PrimitivesMayComeFromFiles) {
                          (dir_ / "p").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("additive primitive from " + kBracket), std::string::npos) << r.out;
+}
+
+}  // namespace
+
+namespace {
+
+const std::string kHybrid3Axis = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/hybrid-3axis.yaml";
+
+TEST_F(Cli, GcodeCheckReportsACleanProgramAndExitsWithZero) {
+  // hybrid-3axis: work zero of G54 at machine (200, 150, 0).
+  const auto file = write("ok.ngc", "G21 G90 G17 G94\nG54\nT1 M6\nS8000 M3\nG0 X0 Y0 Z10\nG1 Z2 F300\n"
+                                    "G2 X0 Y0 I10 J0 F1200\nG0 Z20\nM5\nM2\n");
+  const Outcome r = run({"gcode", "check", file.string(), "--machine", kHybrid3Axis});
+  EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("10 lines, 4 moves (2 rapid, 1 feed, 1 arc)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("estimated time: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("ok.ngc: clean"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, GcodeCheckListsErrorsAndViolationsByLineAndExitsWithThree) {
+  const auto file = write("bad.ngc", "G21 G90\nT1 M6\nS8000 M3\nG0 X0 Y0 Z10\nG1 X10\nG0 X250\nT42 M6\nM2\n");
+  const Outcome r = run({"gcode", "check", file.string(), "--machine", kHybrid3Axis});
+  EXPECT_EQ(r.exit_code, 3) << r.out << r.err;
+  EXPECT_NE(r.out.find("bad.ngc:5:1: error: found G1 with zero feed rate"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("bad.ngc:6: outside the envelope: X reaches 450, beyond the X travel [0, 400]"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("bad.ngc:7:5: unknown tool: T42"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("bad.ngc: 3 problems"), std::string::npos) << r.out;
+}
+
+TEST_F(Cli, GcodeCheckArgumentAndFileErrors) {
+  const auto file = write("ok.ngc", "M2\n");
+  EXPECT_EQ(run({"gcode", "check", file.string()}).exit_code, 2);  // --machine is required
+  const Outcome missing = run({"gcode", "check", (dir_ / "nope.ngc").string(), "--machine", kHybrid3Axis});
+  EXPECT_EQ(missing.exit_code, 3);
+  EXPECT_NE(missing.err.find("nope.ngc: cannot read: No such file or directory"), std::string::npos) << missing.err;
+  const Outcome bad_machine = run({"gcode", "check", file.string(), "--machine", file.string()});
+  EXPECT_EQ(bad_machine.exit_code, 3);
 }
 
 }  // namespace
