@@ -5,3 +5,5 @@ hybridctl_test(deposition_path_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/deposition
   LIBS hybridctl_toolpaths hybridctl_geometry hybridctl_config)
 hybridctl_test(pocket_path_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/pocket_path_test.cpp
   LIBS hybridctl_toolpaths hybridctl_planner hybridctl_geometry hybridctl_config)
+hybridctl_test(toolpath_plan_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/toolpath_plan_test.cpp
+  LIBS hybridctl_toolpaths hybridctl_planner hybridctl_geometry hybridctl_config)
