@@ -117,11 +117,13 @@ std::optional<std::string> envelope_violation(const Motion& m, const config::Env
   const char names[3] = {'X', 'Y', 'Z'};
   for (int axis = 0; axis < 3; ++axis) {
     const config::Range& t = linear(envelope, axis).travel;
+    const bool below = get(lo, axis) < t.min - tolerance, beyond = get(hi, axis) > t.max + tolerance;
+    if (!below && !beyond) continue;  // the common case: no text built
     const std::string travel = std::string(1, names[axis]) + " travel [" + fmt(t.min) + ", " + fmt(t.max) + "]";
-    if (get(lo, axis) < t.min - tolerance)
+    if (below)
       out += std::string(out.empty() ? "" : "; ") + names[axis] + " reaches " + fmt(get(lo, axis)) +
              ", below the " + travel;
-    if (get(hi, axis) > t.max + tolerance)
+    if (beyond)
       out += std::string(out.empty() ? "" : "; ") + names[axis] + " reaches " + fmt(get(hi, axis)) +
              ", beyond the " + travel;
   }
