@@ -1,6 +1,7 @@
 // G-code language throughput on a synthetic ~100k-line milling program for the
 // hybrid-3axis example machine (zigzag rows of G1 moves with a G2/G3 turn between rows):
-//   parser       lines/s of Parser::parse_line into one reused Block
+//   parser       lines/s of Parser::parse_line into one reused Block (the program's lines,
+//                and 100k longer `N.. G1 X.. Y.. Z.. F..` lines)
 //   interpreter  lines/s of Interpreter::execute_line (parse + modal execution)
 //   check        lines/s of check_program (interpretation, envelope, time estimate)
 //   writer       lines/s of write_program (generation + its interpreter/envelope self-check)
@@ -8,6 +9,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -88,6 +90,26 @@ void BM_Parser(benchmark::State& state) {
   state.counters["lines"] = static_cast<double>(lines.size());
 }
 BENCHMARK(BM_Parser)->Unit(benchmark::kMillisecond);
+
+/// Longer lines: every axis, four decimals, a feed and a comment on every tenth line.
+void BM_ParserFullLines(benchmark::State& state) {
+  std::vector<std::string> lines;
+  for (int i = 0; i < 100000; ++i) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "N%d G1 X%.4f Y%.4f Z%.4f F%d%s", i, (i % 997) * 0.1234, -(i % 313) * 0.5678,
+                  (i % 7) * 0.25, 1000 + i % 50, i % 10 == 0 ? " (row)" : "");
+    lines.emplace_back(buf);
+  }
+  const Parser parser("bench.ngc");
+  Block block;
+  for (auto _ : state) {
+    int n = 0;
+    for (const auto& l : lines) parser.parse_line(l, ++n, block);
+    benchmark::DoNotOptimize(block);
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(lines.size()));
+}
+BENCHMARK(BM_ParserFullLines)->Unit(benchmark::kMillisecond);
 
 void BM_Interpreter(benchmark::State& state) {
   const auto lines = program_lines();
