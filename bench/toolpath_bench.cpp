@@ -1,0 +1,127 @@
+// Toolpath generation on a region of about 100^3 voxels (0.5 mm voxels, a 50 mm cube):
+//   - raster deposition of a block with a through hole on a base plate, with the bundled
+//     machine's DED head (1.5 mm bead, 0.6 mm layers, 1.05 mm hatch), with and without
+//     a contour pass;
+//   - Z-level pocketing of a 50 x 50 x 50 mm pocket around a round boss with the bundled
+//     10 mm flat rougher (5 mm step down, 4 mm step over, 42 mm holder), zigzag and
+//     contour-parallel rings, and with the 3 mm flat detail tool (1 mm step down).
+// Counters: moves, cutting/deposition path length (mm), ROI voxels.
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+#include "gcode/deposition_path.hpp"
+#include "gcode/pocket_path.hpp"
+#include "geometry/shapes.hpp"
+
+namespace {
+
+using namespace hybridctl;
+using geometry::Lattice;
+using geometry::Solid;
+
+const Lattice kLattice{0.5, {0, 0, 0}};
+
+config::Setup top() {
+  config::Setup s;
+  s.name = "top";
+  return s;
+}
+
+config::AdditiveHead ded() {
+  config::AdditiveHead h;
+  h.name = "ded";
+  h.bead = {config::BeadShape::Ellipsoid, 1.5, 0.75};
+  h.nozzle = config::Nozzle{20, 60};
+  h.layer_height = 0.6;
+  h.hatch_spacing = 1.05;
+  h.travel_clearance = 5;
+  h.feed = 800;
+  return h;
+}
+
+config::CuttingTool rougher() {
+  config::CuttingTool t;
+  t.number = 1;
+  t.name = "10 mm flat rougher";
+  t.diameter = 10;
+  t.flute_length = 22;
+  t.shank = {10, 50};
+  t.holder = {42, 60};
+  t.feed = 1200;
+  t.plunge_feed = 300;
+  t.step_down = 5;
+  t.step_over = 4;
+  return t;
+}
+
+config::CuttingTool detail() {
+  config::CuttingTool t;
+  t.number = 3;
+  t.name = "3 mm flat detail";
+  t.diameter = 3;
+  t.flute_length = 8;
+  t.shank = {6, 30};
+  t.holder = {35, 60};
+  t.feed = 600;
+  t.plunge_feed = 150;
+  t.step_down = 1;
+  t.step_over = 1.2;
+  return t;
+}
+
+void count(benchmark::State& state, const gcode::Toolpath& p, const Solid& roi) {
+  double length = 0;
+  geometry::Vec3 at = p.start;
+  for (const auto& m : p.moves) {
+    if (m.process_on) length += std::hypot(m.to.x - at.x, m.to.y - at.y, m.to.z - at.z);
+    at = m.to;
+  }
+  state.counters["moves"] = double(p.moves.size());
+  state.counters["path_mm"] = length;
+  state.counters["roi_voxels"] = double(roi.voxel_count());
+  state.counters["warnings"] = double(p.warnings.size());
+}
+
+void BM_Deposition(benchmark::State& state) {
+  const Solid base = geometry::make_box(kLattice, {{0, 0, 0}, {60, 60, 5}});
+  Solid roi = geometry::make_box(kLattice, {{5, 5, 5}, {55, 55, 55}});
+  roi = geometry::subtract(roi, geometry::make_cylinder(kLattice, geometry::Axis::Z, {30, 30, 0}, 8, 60));
+  gcode::DepositionOptions o;
+  if (state.range(0)) o.contour = gcode::ContourPass::BeforeInfill;
+  gcode::Toolpath p;
+  for (auto _ : state) {
+    p = gcode::deposition_path(roi, base, ded(), top(), o);
+    benchmark::DoNotOptimize(p.moves.data());
+  }
+  count(state, p, roi);
+}
+
+void pocket(benchmark::State& state, const config::CuttingTool& tool, gcode::PocketStrategy strategy) {
+  const Solid stock = geometry::make_box(kLattice, {{0, 0, 0}, {60, 60, 55}});
+  Solid roi = geometry::make_box(kLattice, {{5, 5, 5}, {55, 55, 55}});
+  roi = geometry::subtract(roi, geometry::make_cylinder(kLattice, geometry::Axis::Z, {30, 30, 0}, 8, 60));
+  const Solid keep = geometry::subtract(stock, roi);
+  gcode::PocketOptions o;
+  o.strategy = strategy;
+  gcode::Toolpath p;
+  for (auto _ : state) {
+    p = gcode::pocket_path(roi, keep, stock, tool, top(), o);
+    benchmark::DoNotOptimize(p.moves.data());
+  }
+  count(state, p, roi);
+}
+
+void BM_PocketZigzag_Rougher(benchmark::State& s) { pocket(s, rougher(), gcode::PocketStrategy::Zigzag); }
+void BM_PocketOffsets_Rougher(benchmark::State& s) { pocket(s, rougher(), gcode::PocketStrategy::Offsets); }
+void BM_PocketZigzag_Detail(benchmark::State& s) { pocket(s, detail(), gcode::PocketStrategy::Zigzag); }
+
+}  // namespace
+
+BENCHMARK(BM_Deposition)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_PocketZigzag_Rougher)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_PocketOffsets_Rougher)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_PocketZigzag_Detail)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+BENCHMARK_MAIN();
