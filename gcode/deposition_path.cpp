@@ -173,17 +173,19 @@ std::vector<Pass> contour_layer(const SliceMask& region, const geometry::Lattice
 }  // namespace
 
 int head_tool_number(const config::AdditiveHead& head, int fallback) {
-  if constexpr (requires { head.tool_number; }) {
-    if (head.tool_number > 0) return head.tool_number;
-  }
-  return fallback;
+  return head.tool_number > 0 ? head.tool_number : fallback;
 }
 
-Toolpath deposition_path(const Solid& roi_part, const Solid& existing_part, const config::AdditiveHead& head,
+Toolpath deposition_path(const Solid& roi_part, const Solid& existing_part, const config::AdditiveHead& head_in,
                          const config::Setup& setup, const DepositionOptions& options) {
-  if (!(head.bead.width > 0) || !(head.bead.height > 0) || !(head.layer_height > 0) || !(head.hatch_spacing > 0))
-    throw std::invalid_argument("deposition_path: head '" + head.name +
-                                "' needs a positive bead width and height, layer_height and hatch_spacing");
+  if (!(head_in.bead.width > 0) || !(head_in.bead.height > 0))
+    throw std::invalid_argument("deposition_path: head '" + head_in.name + "' needs a positive bead width and height");
+  // The machine file's documented defaults for a head built by hand with them unset.
+  config::AdditiveHead head = head_in;
+  if (!(head.layer_height > 0)) head.layer_height = config::kDefaultLayerHeightFraction * head.bead.height;
+  if (!(head.hatch_spacing > 0)) head.hatch_spacing = config::kDefaultHatchSpacingFraction * head.bead.width;
+  if (!(head.feed > 0)) head.feed = 1000;
+  head.travel_clearance = std::max(0.0, head.travel_clearance);
   const bool has_existing = !existing_part.empty();
   if (has_existing && !(existing_part.lattice() == roi_part.lattice()))
     throw std::invalid_argument("deposition_path: the ROI and the existing material are on different lattices");

@@ -53,12 +53,12 @@ struct DepositionOptions {
   // a bead may overhang its support by a fraction of its width. Default: half the bead
   // width.
   std::optional<double> overhang_reach;
-  // The T number when config::AdditiveHead has no tool_number (machine files before it).
+  // The T number for a head whose tool_number is unset (0, e.g. built by hand); the
+  // machine loader always sets it (default 100 + the head's index).
   int fallback_tool_number = 0;
 };
 
-// The head's T number: its `tool_number` from the machine file when config::AdditiveHead
-// has that field and it is positive, otherwise `fallback`.
+// The head's T number: its tool_number when positive, otherwise `fallback`.
 int head_tool_number(const config::AdditiveHead& head, int fallback);
 
 // The deposition toolpath of one additive action.
@@ -68,8 +68,9 @@ int head_tool_number(const config::AdditiveHead& head, int fallback);
 //   setup     the setup: its approach becomes the work frame's +Z; its name is recorded
 // Moves are in mm in the work frame. Warnings: overhangs (deposit with nothing below),
 // ROI under existing material (not reachable from the approach side: skipped), dropped
-// short segments. Throws std::invalid_argument on solids on different lattices or a head
-// with a non-positive bead, layer height or hatch spacing.
+// short segments. A layer height, hatch spacing or feed left at 0 takes the machine
+// file's default (0.8 x bead height, 0.7 x bead width, 1000 mm/min). Throws
+// std::invalid_argument on solids on different lattices or a head without a bead.
 Toolpath deposition_path(const geometry::Solid& roi, const geometry::Solid& existing, const config::AdditiveHead& head,
                          const config::Setup& setup, const DepositionOptions& options = {});
 

@@ -105,7 +105,10 @@ TEST(DepositionPath, RecordsTheHeadSetupAndFeeds) {
   EXPECT_EQ(p.process, Process::Deposition);
   EXPECT_EQ(p.instrument, "ded");
   EXPECT_EQ(p.setup, "top");
-  EXPECT_EQ(p.tool_number, head_tool_number(ded_head(), 101));
+  EXPECT_EQ(p.tool_number, 101) << "a head without a tool number takes the fallback";
+  auto numbered = ded_head();
+  numbered.tool_number = 105;
+  EXPECT_EQ(deposition_path(roi, Solid(kLattice, {}), numbered, top_setup(), o).tool_number, 105);
   ASSERT_FALSE(p.moves.empty());
   EXPECT_EQ(p.moves.front().kind, MoveKind::Rapid);
   EXPECT_EQ(p.moves.front().to, p.start);

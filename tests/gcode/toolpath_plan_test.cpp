@@ -63,6 +63,8 @@ TEST(ToolpathsForAPlan, BracketOnTheHybridMachine) {
       const config::AdditiveHead& head = *machine.find_head(prim.capability);
       const Solid roi = geometry::subtract(prim.region, state);
       const Toolpath p = deposition_path(roi, state, head, setup);
+      EXPECT_EQ(p.tool_number, head.tool_number);
+      EXPECT_GE(p.tool_number, 100);
       const Solid roi_w = part_to_work(roi, setup.approach);
       const double h = r.lattice.voxel_size;
       int outside = 0, segments = 0;
