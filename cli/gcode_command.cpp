@@ -21,8 +21,7 @@ void add_gcode_command(CLI::App& app, Runner& runner) {
   auto file = std::make_shared<std::string>();
   auto machine_file = std::make_shared<std::string>();
   check->add_option("FILE", *file, "G-code program (RS274NGC/LinuxCNC or Fanuc-style)")->required();
-  check->add_option("--machine,-m", *machine_file, "Machine description (YAML), see docs/machine-file.md")
-      ->required();
+  check->add_option("--machine,-m", *machine_file, "Machine description (YAML), see docs/machine-file.md")->required();
   check->callback([&runner, file, machine_file] {
     runner = [file, machine_file] {
       const config::Machine machine = config::load_machine(*machine_file);

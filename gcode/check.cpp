@@ -117,15 +117,15 @@ std::optional<std::string> envelope_violation(const Motion& m, const config::Env
   const char names[3] = {'X', 'Y', 'Z'};
   for (int axis = 0; axis < 3; ++axis) {
     const config::Range& t = linear(envelope, axis).travel;
-    const bool below = get(lo, axis) < t.min - tolerance, beyond = get(hi, axis) > t.max + tolerance;
+    const bool below = get(lo, axis)<t.min - tolerance, beyond = get(hi, axis)> t.max + tolerance;
     if (!below && !beyond) continue;  // the common case: no text built
     const std::string travel = std::string(1, names[axis]) + " travel [" + fmt(t.min) + ", " + fmt(t.max) + "]";
     if (below)
-      out += std::string(out.empty() ? "" : "; ") + names[axis] + " reaches " + fmt(get(lo, axis)) +
-             ", below the " + travel;
+      out += std::string(out.empty() ? "" : "; ") + names[axis] + " reaches " + fmt(get(lo, axis)) + ", below the " +
+             travel;
     if (beyond)
-      out += std::string(out.empty() ? "" : "; ") + names[axis] + " reaches " + fmt(get(hi, axis)) +
-             ", beyond the " + travel;
+      out += std::string(out.empty() ? "" : "; ") + names[axis] + " reaches " + fmt(get(hi, axis)) + ", beyond the " +
+             travel;
   }
   const std::pair<char, std::pair<double, double>> rotary[3] = {{'A', {m.from_rotary.a, m.to_rotary.a}},
                                                                 {'B', {m.from_rotary.b, m.to_rotary.b}},
@@ -225,7 +225,8 @@ CheckReport check_program(std::string_view text, const config::Machine& machine,
   bool warned_spindle_stopped = false;  // one finding per run of feed moves with the spindle stopped
 
   const auto tool_name = [&](int number) -> std::string {
-    if (const config::CuttingTool* t = machine.find_tool(number)) return "T" + std::to_string(number) + " (" + t->name + ")";
+    if (const config::CuttingTool* t = machine.find_tool(number))
+      return "T" + std::to_string(number) + " (" + t->name + ")";
     if (const config::AdditiveHead* h = machine.find_head_by_tool(number))
       return "T" + std::to_string(number) + " (head " + h->name + ")";
     return "T" + std::to_string(number);
@@ -248,28 +249,32 @@ CheckReport check_program(std::string_view text, const config::Machine& machine,
           ++report.time.tool_changes;
           if (e.tool != 0 && !machine.find_tool(e.tool) && !machine.find_head_by_tool(e.tool)) {
             std::string known;
-            for (const auto& t : machine.tools) known += (known.empty() ? "" : ", ") + std::string("T") + std::to_string(t.number);
+            for (const auto& t : machine.tools)
+              known += (known.empty() ? "" : ", ") + std::string("T") + std::to_string(t.number);
             for (const auto& h : machine.heads)
-              known += (known.empty() ? "" : ", ") + std::string("T") + std::to_string(h.tool_number) + " (" + h.name + ")";
+              known +=
+                  (known.empty() ? "" : ", ") + std::string("T") + std::to_string(h.tool_number) + " (" + h.name + ")";
             add(report.tools, more, max,
-                Finding{e.line, e.column, "T" + std::to_string(e.tool) + " is neither a cutting tool nor a head of machine '" +
-                                              machine.name + "'; expected one of " + known});
+                Finding{e.line, e.column,
+                        "T" + std::to_string(e.tool) + " is neither a cutting tool nor a head of machine '" +
+                            machine.name + "'; expected one of " + known});
           }
           break;
         case EventKind::DepositionOn:
           if (!head_active_after)
             add(report.process, more, max,
                 Finding{e.line, e.column,
-                        "deposition on for head '" + machine.heads[static_cast<std::size_t>(e.index)].name + "' while " +
-                            (after.tool == 0 ? std::string("no tool") : tool_name(after.tool)) +
-                            " is in the spindle; expected the head selected first (T" + std::to_string(e.tool) +
-                            " " + machine.gcode.m_codes.tool_change + ")"});
+                        "deposition on for head '" + machine.heads[static_cast<std::size_t>(e.index)].name +
+                            "' while " + (after.tool == 0 ? std::string("no tool") : tool_name(after.tool)) +
+                            " is in the spindle; expected the head selected first (T" + std::to_string(e.tool) + " " +
+                            machine.gcode.m_codes.tool_change + ")"});
           break;
         case EventKind::SpindleStart:
           if (head_active_after)
             add(report.process, more, max,
-                Finding{e.line, e.column, "spindle started while " + tool_name(after.tool) +
-                                              " is active; expected a cutting tool in the spindle"});
+                Finding{e.line, e.column,
+                        "spindle started while " + tool_name(after.tool) +
+                            " is active; expected a cutting tool in the spindle"});
           break;
         case EventKind::Dwell: report.time.dwell += e.value; break;
         case EventKind::ProgramStop:
@@ -309,9 +314,10 @@ CheckReport check_program(std::string_view text, const config::Machine& machine,
         if (cutting_tool && m.spindle == SpindleState::Off) {
           if (!warned_spindle_stopped)
             add(report.process, more, max,
-                Finding{m.line, 0, "feed move with " + tool_name(m.tool) +
-                                       " and the spindle stopped; expected the spindle started (" +
-                                       machine.gcode.m_codes.spindle_cw + ") before cutting"});
+                Finding{m.line, 0,
+                        "feed move with " + tool_name(m.tool) +
+                            " and the spindle stopped; expected the spindle started (" +
+                            machine.gcode.m_codes.spindle_cw + ") before cutting"});
           warned_spindle_stopped = true;
         } else {
           warned_spindle_stopped = false;
@@ -321,8 +327,9 @@ CheckReport check_program(std::string_view text, const config::Machine& machine,
   });
   if (!report.program_end)
     add(report.errors, more, max,
-        Finding{report.lines, 0, "the program has no end; expected " + machine.gcode.m_codes.program_end +
-                                     " (or M2/M30) as its last code, as LinuxCNC requires"});
+        Finding{report.lines, 0,
+                "the program has no end; expected " + machine.gcode.m_codes.program_end +
+                    " (or M2/M30) as its last code, as LinuxCNC requires"});
   report.time.total = report.time.feed + report.time.rapid + report.time.dwell;
   return report;
 }
@@ -353,8 +360,8 @@ std::string CheckReport::str() const {
     out += "; " + std::to_string(time.program_stops) + " program stop" + (time.program_stops == 1 ? "" : "s") +
            " not counted";
   if (time.tool_changes > 0)
-    out += "; " + std::to_string(time.tool_changes) + " tool change" + (time.tool_changes == 1 ? "" : "s") +
-           " not timed";
+    out +=
+        "; " + std::to_string(time.tool_changes) + " tool change" + (time.tool_changes == 1 ? "" : "s") + " not timed";
   out += ")\n";
   const int n = problems();
   out += file + ": " + (n == 0 ? std::string("clean") : std::to_string(n) + (n == 1 ? " problem" : " problems")) + "\n";

@@ -20,9 +20,7 @@ std::string reason(int code) { return std::generic_category().message(code); }
 
 /// Fills the atomic file's temporary file with `text`.
 void fill(const AtomicFile& file, std::string_view text) {
-  const auto fail = [&](int code) {
-    return InputError(file.target().string() + ": cannot write: " + reason(code));
-  };
+  const auto fail = [&](int code) { return InputError(file.target().string() + ": cannot write: " + reason(code)); };
   const int fd = ::open(file.temp_path().c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw fail(errno);
   std::size_t done = 0;

@@ -49,8 +49,9 @@ constexpr std::uint32_t bit(char letter) { return 1u << (letter - 'A'); }
 constexpr std::uint32_t kAxisLetters = bit('X') | bit('Y') | bit('Z') | bit('A') | bit('B') | bit('C');
 constexpr std::uint32_t kArcLetters = bit('I') | bit('J') | bit('K') | bit('R');
 
-const char* const kKnownG = "G0, G1, G2, G3, G4, G17, G18, G19, G20, G21, G40, G43, G49, G53, G54..G59, G61, "
-                            "G61.1, G64, G80, G90, G90.1, G91, G91.1, G94";
+const char* const kKnownG =
+    "G0, G1, G2, G3, G4, G17, G18, G19, G20, G21, G40, G43, G49, G53, G54..G59, G61, "
+    "G61.1, G64, G80, G90, G90.1, G91, G91.1, G94";
 
 }  // namespace
 
@@ -162,7 +163,10 @@ void Interpreter::run(const Block& b, ModalState& s) {
   if (b.no_words()) return;
   if (b.program_number >= 0) return;  // a Fanuc O line: the parser allows nothing else on it
   if (s.ended)
-    fail(b, b.g_count ? b.g[0].column : b.m_count ? b.m[0].column : 1,
+    fail(b,
+         b.g_count   ? b.g[0].column
+         : b.m_count ? b.m[0].column
+                     : 1,
          "found words after the program end; expected nothing but comments or '%' after M2/M30");
 
   std::uint32_t used = 0;  // letters some code used
@@ -178,31 +182,86 @@ void Interpreter::run(const Block& b, ModalState& s) {
     Slot* slot = nullptr;
     const char* group = "";
     switch (c.value) {
-      case 0: case 10: case 20: case 30: case 800: slot = &motion; group = "motion"; break;
-      case 170: case 180: case 190: slot = &plane; group = "plane"; break;
-      case 900: case 910: slot = &distance; group = "distance mode"; break;
-      case 901: case 911: slot = &arc_distance; group = "arc distance mode"; break;
-      case 940: slot = &feed_mode; group = "feed mode"; break;
-      case 200: case 210: slot = &units; group = "units"; break;
-      case 400: slot = &cutter; group = "cutter compensation"; break;
-      case 430: case 490: slot = &length; group = "tool length offset"; break;
-      case 540: case 550: case 560: case 570: case 580: case 590: slot = &coords; group = "work offset"; break;
-      case 610: case 611: case 640: slot = &path; group = "path control"; break;
-      case 40: slot = &dwell; group = "non-modal"; break;
-      case 530: slot = &machine_coords; group = "non-modal"; break;
-      case 930:
-        fail(b, c.column, "found G93: inverse time feed is not supported; expected G94 (units per minute)");
-      case 410: case 420:
-        fail(b, c.column, "found " + g_code_name(c.value) +
-                              ": cutter radius compensation is not supported; expected toolpaths of the tool centre "
-                              "(G40)");
+      case 0:
+      case 10:
+      case 20:
+      case 30:
+      case 800:
+        slot = &motion;
+        group = "motion";
+        break;
+      case 170:
+      case 180:
+      case 190:
+        slot = &plane;
+        group = "plane";
+        break;
+      case 900:
+      case 910:
+        slot = &distance;
+        group = "distance mode";
+        break;
+      case 901:
+      case 911:
+        slot = &arc_distance;
+        group = "arc distance mode";
+        break;
+      case 940:
+        slot = &feed_mode;
+        group = "feed mode";
+        break;
+      case 200:
+      case 210:
+        slot = &units;
+        group = "units";
+        break;
+      case 400:
+        slot = &cutter;
+        group = "cutter compensation";
+        break;
+      case 430:
+      case 490:
+        slot = &length;
+        group = "tool length offset";
+        break;
+      case 540:
+      case 550:
+      case 560:
+      case 570:
+      case 580:
+      case 590:
+        slot = &coords;
+        group = "work offset";
+        break;
+      case 610:
+      case 611:
+      case 640:
+        slot = &path;
+        group = "path control";
+        break;
+      case 40:
+        slot = &dwell;
+        group = "non-modal";
+        break;
+      case 530:
+        slot = &machine_coords;
+        group = "non-modal";
+        break;
+      case 930: fail(b, c.column, "found G93: inverse time feed is not supported; expected G94 (units per minute)");
+      case 410:
+      case 420:
+        fail(b, c.column,
+             "found " + g_code_name(c.value) +
+                 ": cutter radius compensation is not supported; expected toolpaths of the tool centre "
+                 "(G40)");
       default:
-        fail(b, c.column, "found " + g_code_name(c.value) + ", an unknown or unsupported G code; expected one of " +
-                              kKnownG);
+        fail(b, c.column,
+             "found " + g_code_name(c.value) + ", an unknown or unsupported G code; expected one of " + kKnownG);
     }
     if (slot->code >= 0)
-      fail(b, c.column, "found " + g_code_name(c.value) + " after " + g_code_name(slot->code) +
-                            " on one line: two codes of the " + group + " group; expected at most one");
+      fail(b, c.column,
+           "found " + g_code_name(c.value) + " after " + g_code_name(slot->code) + " on one line: two codes of the " +
+               group + " group; expected at most one");
     *slot = {c.value, c.column};
   }
   if (dwell.code >= 0 && motion.code >= 0)
@@ -222,7 +281,8 @@ void Interpreter::run(const Block& b, ModalState& s) {
   int action_count = 0;
   int tool_after_change = s.tool;
   for (int i = 0; i < b.m_count; ++i)
-    if (role_of(b.m[i].value) == MRole::ToolChange) tool_after_change = b.has('T') ? int(b.value('T')) : s.selected_tool;
+    if (role_of(b.m[i].value) == MRole::ToolChange)
+      tool_after_change = b.has('T') ? int(b.value('T')) : s.selected_tool;
   for (int i = 0; i < b.m_count; ++i) {
     const Code c = b.m[i];
     MAction a;
@@ -235,8 +295,7 @@ void Interpreter::run(const Block& b, ModalState& s) {
       if (hc.m != c.value) continue;
       if (hc.p >= 0 && !(b.has('P') && b.value('P') == hc.p)) continue;
       const MRole role = role_of(c.value);
-      if (role != MRole::None &&
-          tool_after_change != machine_.heads[static_cast<std::size_t>(hc.head)].tool_number)
+      if (role != MRole::None && tool_after_change != machine_.heads[static_cast<std::size_t>(hc.head)].tool_number)
         continue;
       a.head_code = static_cast<int>(k);
       break;
@@ -247,25 +306,32 @@ void Interpreter::run(const Block& b, ModalState& s) {
     } else {
       a.role = role_of(c.value);
       switch (a.role) {
-        case MRole::Stop: case MRole::OptionalStop: case MRole::End: group = kStop; break;
+        case MRole::Stop:
+        case MRole::OptionalStop:
+        case MRole::End: group = kStop; break;
         case MRole::ToolChange: group = kToolChange; break;
-        case MRole::SpindleCw: case MRole::SpindleCcw: case MRole::SpindleStop: group = kSpindle; break;
-        case MRole::CoolantOn: case MRole::CoolantOff: group = kCoolant; break;
+        case MRole::SpindleCw:
+        case MRole::SpindleCcw:
+        case MRole::SpindleStop: group = kSpindle; break;
+        case MRole::CoolantOn:
+        case MRole::CoolantOff: group = kCoolant; break;
         case MRole::None:
           if ((c.value >= 62 && c.value <= 65) || c.value == 67 || c.value == 68) {
             a.io = c.value;
           } else {
-            fail(b, c.column, "found " + m_code_name(c.value) +
-                                  ", an unknown M code; expected M0, M1, M2, M3, M4, M5, M6, M7, M8, M9, M30, "
-                                  "M62..M65, M67, M68 or one of the machine's codes (gcode.m_codes, "
-                                  "heads[].codes)");
+            fail(b, c.column,
+                 "found " + m_code_name(c.value) +
+                     ", an unknown M code; expected M0, M1, M2, M3, M4, M5, M6, M7, M8, M9, M30, "
+                     "M62..M65, M67, M68 or one of the machine's codes (gcode.m_codes, "
+                     "heads[].codes)");
           }
           break;
       }
     }
     if (group_column[group] != 0)
-      fail(b, c.column, "found " + m_code_name(c.value) + " and another M code of the same group (column " +
-                            std::to_string(group_column[group]) + ") on one line; expected at most one");
+      fail(b, c.column,
+           "found " + m_code_name(c.value) + " and another M code of the same group (column " +
+               std::to_string(group_column[group]) + ") on one line; expected at most one");
     group_column[group] = c.column;
     actions[static_cast<std::size_t>(action_count++)] = a;
   }
@@ -350,21 +416,22 @@ void Interpreter::run(const Block& b, ModalState& s) {
     }
     if (a.io >= 62 && a.io <= 65) {
       if (!b.has('P'))
-        fail(b, a.column, "found " + m_code_name(a.io) + " with no P word; expected the output number, e.g. " +
-                              m_code_name(a.io) + " P0");
+        fail(b, a.column,
+             "found " + m_code_name(a.io) + " with no P word; expected the output number, e.g. " + m_code_name(a.io) +
+                 " P0");
       const double p = b.value('P');
       if (p < 0 || p != std::nearbyint(p))
-        fail(b, b.column('P'), "found P" + fmt(p) + " with " + m_code_name(a.io) +
-                                   "; expected an output number, a whole number from 0");
+        fail(b, b.column('P'),
+             "found P" + fmt(p) + " with " + m_code_name(a.io) + "; expected an output number, a whole number from 0");
       used |= bit('P');
       Event& e = event(EventKind::DigitalOutput, a.column);
       e.index = static_cast<int>(p);
       e.value = (a.io == 62 || a.io == 64) ? 1.0 : 0.0;
     } else if (a.io == 67 || a.io == 68) {
       if (!b.has('E') || !b.has('Q'))
-        fail(b, a.column, "found " + m_code_name(a.io) + " without " + (b.has('E') ? "Q" : "E") +
-                              "; expected the output number E and its value Q, e.g. " + m_code_name(a.io) +
-                              " E0 Q800");
+        fail(b, a.column,
+             "found " + m_code_name(a.io) + " without " + (b.has('E') ? "Q" : "E") +
+                 "; expected the output number E and its value Q, e.g. " + m_code_name(a.io) + " E0 Q800");
       const double e_number = b.value('E');
       if (e_number < 0 || e_number != std::nearbyint(e_number))
         fail(b, b.column('E'), "found E" + fmt(e_number) + "; expected an analog output number, a whole number");
@@ -377,8 +444,7 @@ void Interpreter::run(const Block& b, ModalState& s) {
 
   // ---- dwell
   if (dwell.code >= 0) {
-    if (!b.has('P'))
-      fail(b, dwell.column, "found G4 with no P word; expected the dwell time in seconds, e.g. G4 P0.5");
+    if (!b.has('P')) fail(b, dwell.column, "found G4 with no P word; expected the dwell time in seconds, e.g. G4 P0.5");
     const double seconds = b.value('P');
     if (seconds < 0) fail(b, b.column('P'), "found P" + fmt(seconds) + " with G4; expected a dwell of 0 s or more");
     used |= bit('P');
@@ -405,8 +471,9 @@ void Interpreter::run(const Block& b, ModalState& s) {
       std::string known;
       for (const auto& st : machine_.setups)
         known += (known.empty() ? "" : ", ") + std::string("G") + std::to_string(st.work_offset) + " (" + st.name + ")";
-      fail(b, coords.column, "found G" + std::to_string(offset) + ", a work offset no setup of machine '" +
-                                 machine_.name + "' uses; expected one of " + known);
+      fail(b, coords.column,
+           "found G" + std::to_string(offset) + ", a work offset no setup of machine '" + machine_.name +
+               "' uses; expected one of " + known);
     }
     s.work_offset = offset;
     s.offset = {setup->work_origin[0], setup->work_origin[1], setup->work_origin[2]};
@@ -419,9 +486,10 @@ void Interpreter::run(const Block& b, ModalState& s) {
   if (motion.code >= 0) {
     s.motion_active = motion.code != 800;
     if (s.motion_active)
-      s.motion = motion.code == 0 ? MotionKind::Rapid : motion.code == 10 ? MotionKind::Feed
-                 : motion.code == 20                  ? MotionKind::ArcCw
-                                                      : MotionKind::ArcCcw;
+      s.motion = motion.code == 0    ? MotionKind::Rapid
+                 : motion.code == 10 ? MotionKind::Feed
+                 : motion.code == 20 ? MotionKind::ArcCw
+                                     : MotionKind::ArcCcw;
   }
   const std::uint32_t axis_words = b.letters & kAxisLetters;
   int first_axis_column = 0;
@@ -429,18 +497,21 @@ void Interpreter::run(const Block& b, ModalState& s) {
     if (b.has(L) && (first_axis_column == 0 || b.column(L) < first_axis_column)) first_axis_column = b.column(L);
   if (machine_coords.code >= 0) {
     if (!s.motion_active || (s.motion != MotionKind::Rapid && s.motion != MotionKind::Feed))
-      fail(b, machine_coords.column, "found G53 without G0 or G1; expected G53 G0 or G53 G1 (machine coordinates "
-                                     "apply to straight moves only)");
+      fail(b, machine_coords.column,
+           "found G53 without G0 or G1; expected G53 G0 or G53 G1 (machine coordinates "
+           "apply to straight moves only)");
     if (!s.absolute)
-      fail(b, machine_coords.column, "found G53 in incremental mode (G91); expected G90 for moves in machine "
-                                     "coordinates");
+      fail(b, machine_coords.column,
+           "found G53 in incremental mode (G91); expected G90 for moves in machine "
+           "coordinates");
   }
   // LinuxCNC runs a G2/G3 with centre offsets and no axis words as a full circle.
   const bool arc_mode = s.motion_active && (s.motion == MotionKind::ArcCw || s.motion == MotionKind::ArcCcw);
   if (axis_words != 0 || (arc_mode && (b.letters & kArcLetters) != 0)) {
     if (!s.motion_active)
-      fail(b, first_axis_column, "found axis words with no motion mode in effect; expected G0, G1, G2 or G3 on "
-                                 "this or an earlier line");
+      fail(b, first_axis_column,
+           "found axis words with no motion mode in effect; expected G0, G1, G2 or G3 on "
+           "this or an earlier line");
     used |= axis_words;
     Motion m;
     m.line = b.line;
@@ -467,8 +538,12 @@ void Interpreter::run(const Block& b, ModalState& s) {
     const int motion_column = motion.code >= 0 ? motion.column : first_axis_column;
     if (m.kind != MotionKind::Rapid) {
       if (s.feed <= 0)
-        fail(b, motion_column, "found " + std::string(m.kind == MotionKind::Feed ? "G1" : m.is_arc() && m.kind == MotionKind::ArcCw ? "G2" : "G3") +
-                                   " with zero feed rate; expected an F word greater than 0 on this or an earlier line");
+        fail(b, motion_column,
+             "found " +
+                 std::string(m.kind == MotionKind::Feed                  ? "G1"
+                             : m.is_arc() && m.kind == MotionKind::ArcCw ? "G2"
+                                                                         : "G3") +
+                 " with zero feed rate; expected an F word greater than 0 on this or an earlier line");
       m.feed = s.feed;
     }
     if (m.is_arc()) {
@@ -478,31 +553,35 @@ void Interpreter::run(const Block& b, ModalState& s) {
       const std::uint32_t plane_offsets = bit(pa.first_offset) | bit(pa.second_offset);
       for (char L : {'I', 'J', 'K'})
         if (b.has(L) && !(plane_offsets & bit(L)))
-          fail(b, b.column(L), "found " + std::string(1, L) + " with " + gname + " in the " + pa.name +
-                                   " plane; expected only " + pa.first_offset + " and " + pa.second_offset +
-                                   " (or R) for arcs in that plane");
+          fail(b, b.column(L),
+               "found " + std::string(1, L) + " with " + gname + " in the " + pa.name + " plane; expected only " +
+                   pa.first_offset + " and " + pa.second_offset + " (or R) for arcs in that plane");
       const double x0 = at(s.position, pa.first), y0 = at(s.position, pa.second);
       const double x1 = at(to, pa.first), y1 = at(to, pa.second);
       double cx = 0, cy = 0;
       if (b.has('R')) {
         if (arc_words & plane_offsets)
-          fail(b, b.column('R'), std::string("found R with ") + pa.first_offset + "/" + pa.second_offset +
-                                     " offsets; expected either a radius R or centre offsets, not both");
+          fail(b, b.column('R'),
+               std::string("found R with ") + pa.first_offset + "/" + pa.second_offset +
+                   " offsets; expected either a radius R or centre offsets, not both");
         const char first_letter = letters[pa.first], second_letter = letters[pa.second];
         if (!b.has(first_letter) && !b.has(second_letter))
-          fail(b, motion_column, "found " + std::string(gname) + " with R and no " + pa.axes +
-                                     " word; expected the arc's end point in the " + pa.name +
-                                     " plane (an R arc cannot be a full circle)");
+          fail(b, motion_column,
+               "found " + std::string(gname) + " with R and no " + pa.axes +
+                   " word; expected the arc's end point in the " + pa.name +
+                   " plane (an R arc cannot be a full circle)");
         const double radius = b.value('R') * unit;
         if (x0 == x1 && y0 == y1)
-          fail(b, b.column('R'), "found an R arc that ends where it starts; expected a different end point (use I/J "
-                                 "offsets for a full circle)");
+          fail(b, b.column('R'),
+               "found an R arc that ends where it starts; expected a different end point (use I/J "
+               "offsets for a full circle)");
         const double abs_radius = std::abs(radius);
         const double mx = 0.5 * (x0 + x1), my = 0.5 * (y0 + y1);
         double half = std::hypot(x1 - mx, y1 - my);
         if (half - abs_radius > kRadiusTolerance)
-          fail(b, b.column('R'), "found R" + fmt(b.value('R')) + ", too small to reach the end point (half the chord is " +
-                                     fmt(half / unit) + "); expected a radius of at least " + fmt(half / unit));
+          fail(b, b.column('R'),
+               "found R" + fmt(b.value('R')) + ", too small to reach the end point (half the chord is " +
+                   fmt(half / unit) + "); expected a radius of at least " + fmt(half / unit));
         if (half / abs_radius > 1 - 1e-12) half = abs_radius;
         const bool cw = m.kind == MotionKind::ArcCw;
         double theta = std::atan2(y1 - y0, x1 - x0) + ((cw && radius > 0) || (!cw && radius < 0) ? -M_PI_2 : M_PI_2);
@@ -512,9 +591,10 @@ void Interpreter::run(const Block& b, ModalState& s) {
         used |= bit('R');
       } else {
         if (!(arc_words & plane_offsets))
-          fail(b, motion_column, "found " + std::string(gname) + " with no " + pa.first_offset + ", " +
-                                     pa.second_offset + " or R; expected the centre as " + pa.first_offset + "/" +
-                                     pa.second_offset + " offsets or a radius R");
+          fail(b, motion_column,
+               "found " + std::string(gname) + " with no " + pa.first_offset + ", " + pa.second_offset +
+                   " or R; expected the centre as " + pa.first_offset + "/" + pa.second_offset +
+                   " offsets or a radius R");
         const double i = b.has(pa.first_offset) ? b.value(pa.first_offset) * unit : 0.0;
         const double j = b.has(pa.second_offset) ? b.value(pa.second_offset) * unit : 0.0;
         if (s.arc_absolute) {
@@ -527,15 +607,16 @@ void Interpreter::run(const Block& b, ModalState& s) {
         const double r0 = std::hypot(x0 - cx, y0 - cy), r1 = std::hypot(x1 - cx, y1 - cy);
         const int column = b.has(pa.first_offset) ? b.column(pa.first_offset) : b.column(pa.second_offset);
         if (r0 < kRadiusTolerance || r1 < kRadiusTolerance)
-          fail(b, column, "found an arc of zero radius (start radius " + fmt(r0 / unit) + ", end radius " +
-                              fmt(r1 / unit) + "); expected the centre away from the start and end points");
+          fail(b, column,
+               "found an arc of zero radius (start radius " + fmt(r0 / unit) + ", end radius " + fmt(r1 / unit) +
+                   "); expected the centre away from the start and end points");
         const double abs_err = std::abs(r0 - r1);
         const double rel_err = abs_err / std::max(r0, r1);
         if (abs_err > options_.arc_radius_tolerance || rel_err > options_.arc_relative_tolerance)
-          fail(b, column, "radius to end of arc differs from radius to start: start radius " + fmt(r0 / unit) +
-                              ", end radius " + fmt(r1 / unit) + " (difference " + fmt(abs_err / unit) +
-                              "); expected them equal within " + fmt(options_.arc_radius_tolerance) + " mm and " +
-                              fmt(options_.arc_relative_tolerance * 100) + " %");
+          fail(b, column,
+               "radius to end of arc differs from radius to start: start radius " + fmt(r0 / unit) + ", end radius " +
+                   fmt(r1 / unit) + " (difference " + fmt(abs_err / unit) + "); expected them equal within " +
+                   fmt(options_.arc_radius_tolerance) + " mm and " + fmt(options_.arc_relative_tolerance * 100) + " %");
         used |= arc_words & plane_offsets;
       }
       Vec3 centre = s.position;
@@ -569,13 +650,18 @@ void Interpreter::run(const Block& b, ModalState& s) {
       const char L = static_cast<char>('A' + k);
       std::string why;
       switch (L) {
-        case 'I': case 'J': case 'K': case 'R': why = "expected it only with G2 or G3"; break;
+        case 'I':
+        case 'J':
+        case 'K':
+        case 'R': why = "expected it only with G2 or G3"; break;
         case 'P': why = "expected it only with G4, M62..M65 or a head's code"; break;
-        case 'E': case 'Q': why = "expected it only with M67 or M68"; break;
+        case 'E':
+        case 'Q': why = "expected it only with M67 or M68"; break;
         case 'H': why = "expected it only with G43"; break;
         default: why = "hybridctl does not use " + std::string(1, L) + " words"; break;
       }
-      fail(b, b.column(L), "found " + std::string(1, L) + fmt(b.value(L)) + " with nothing on the line to use it; " + why);
+      fail(b, b.column(L),
+           "found " + std::string(1, L) + fmt(b.value(L)) + " with nothing on the line to use it; " + why);
     }
   }
 

@@ -53,50 +53,50 @@ struct Rotary {
 
 /// One executed motion and the state it ran in.
 struct Motion {
-  int line = 0;                  ///< source line number
+  int line = 0;  ///< source line number
   MotionKind kind = MotionKind::Rapid;
-  Vec3 from_work, to_work;       ///< mm, in the work frame of the active offset
-  Vec3 from_machine, to_machine; ///< mm, machine frame
-  Rotary from_rotary, to_rotary; ///< degrees
+  Vec3 from_work, to_work;           ///< mm, in the work frame of the active offset
+  Vec3 from_machine, to_machine;     ///< mm, machine frame
+  Rotary from_rotary, to_rotary;     ///< degrees
   Vec3 centre_work, centre_machine;  ///< arcs: the centre (its plane-normal coordinate is the start's)
-  Plane plane = Plane::XY;       ///< arcs: the plane of the circle
-  double feed = 0;               ///< mm/min; 0 for rapids (they run at the axes' max_feed)
-  int tool = 0;                  ///< the tool (or head) in the spindle; 0 for none
-  int work_offset = 54;          ///< 54..59; 53 for a G53 move in machine coordinates
+  Plane plane = Plane::XY;           ///< arcs: the plane of the circle
+  double feed = 0;                   ///< mm/min; 0 for rapids (they run at the axes' max_feed)
+  int tool = 0;                      ///< the tool (or head) in the spindle; 0 for none
+  int work_offset = 54;              ///< 54..59; 53 for a G53 move in machine coordinates
   SpindleState spindle = SpindleState::Off;
-  double spindle_speed = 0;      ///< rpm, as last set by S
-  bool deposition = false;       ///< a head's deposition is on during this motion
-  bool coolant = false;          ///< M7 or M8 in effect
+  double spindle_speed = 0;  ///< rpm, as last set by S
+  bool deposition = false;   ///< a head's deposition is on during this motion
+  bool coolant = false;      ///< M7 or M8 in effect
 
   bool is_arc() const { return kind == MotionKind::ArcCw || kind == MotionKind::ArcCcw; }
 };
 
 enum class EventKind {
-  ToolChange,      ///< M6: `tool` is the new tool (0: empty)
-  SpindleStart,    ///< M3/M4 (or the machine's codes): `value` rpm
-  SpindleStop,     ///< M5
-  CoolantOn,       ///< M7/M8
-  CoolantOff,      ///< M9
-  DepositionOn,    ///< a head's on code: `index` = head index, `tool` = its T number
-  DepositionOff,   ///< a head's off code
-  DigitalOutput,   ///< M62..M65 that is no head's code: `index` = P, `value` 1 on / 0 off
-  AnalogOutput,    ///< M67/M68: `index` = E, `value` = Q
-  Dwell,           ///< G4: `value` seconds
-  WorkOffset,      ///< G54..G59: `index` = 54..59
-  ProgramStop,     ///< M0 (or the machine's program_stop): `message` for the operator
-  OptionalStop,    ///< M1
-  ProgramEnd,      ///< M2/M30 (or the machine's program_end)
+  ToolChange,     ///< M6: `tool` is the new tool (0: empty)
+  SpindleStart,   ///< M3/M4 (or the machine's codes): `value` rpm
+  SpindleStop,    ///< M5
+  CoolantOn,      ///< M7/M8
+  CoolantOff,     ///< M9
+  DepositionOn,   ///< a head's on code: `index` = head index, `tool` = its T number
+  DepositionOff,  ///< a head's off code
+  DigitalOutput,  ///< M62..M65 that is no head's code: `index` = P, `value` 1 on / 0 off
+  AnalogOutput,   ///< M67/M68: `index` = E, `value` = Q
+  Dwell,          ///< G4: `value` seconds
+  WorkOffset,     ///< G54..G59: `index` = 54..59
+  ProgramStop,    ///< M0 (or the machine's program_stop): `message` for the operator
+  OptionalStop,   ///< M1
+  ProgramEnd,     ///< M2/M30 (or the machine's program_end)
 };
 
 struct Event {
   int line = 0;
-  int column = 0;                ///< of the code that caused it
+  int column = 0;  ///< of the code that caused it
   EventKind kind = EventKind::ToolChange;
   int tool = 0;
   int index = 0;
   double value = 0;
-  bool after_motion = false;     ///< happens after the line's motion (stops and program end)
-  std::string message;           ///< stops: the operator message, from the line's or the preceding comment
+  bool after_motion = false;  ///< happens after the line's motion (stops and program end)
+  std::string message;        ///< stops: the operator message, from the line's or the preceding comment
 };
 
 /// What one line did, in order: events with after_motion false, then the motions, then
@@ -112,22 +112,22 @@ struct LineResult {
 
 /// The modal state between lines.
 struct ModalState {
-  Vec3 position;                 ///< machine frame, mm
+  Vec3 position;  ///< machine frame, mm
   Rotary rotary;
   MotionKind motion = MotionKind::Rapid;
-  bool motion_active = false;    ///< false after G80 and at the start: axis words need a G0..G3 first
+  bool motion_active = false;  ///< false after G80 and at the start: axis words need a G0..G3 first
   Plane plane = Plane::XY;
-  bool absolute = true;          ///< G90 / G91
-  bool arc_absolute = false;     ///< G90.1 / G91.1 (the default: I J K relative to the start)
-  bool inches = false;           ///< G20 / G21
-  int work_offset = 54;          ///< 54..59
-  Vec3 offset;                   ///< the active work offset (machine coordinates of work zero)
-  double feed = 0;               ///< mm/min
-  double spindle_speed = 0;      ///< rpm
+  bool absolute = true;       ///< G90 / G91
+  bool arc_absolute = false;  ///< G90.1 / G91.1 (the default: I J K relative to the start)
+  bool inches = false;        ///< G20 / G21
+  int work_offset = 54;       ///< 54..59
+  Vec3 offset;                ///< the active work offset (machine coordinates of work zero)
+  double feed = 0;            ///< mm/min
+  double spindle_speed = 0;   ///< rpm
   SpindleState spindle = SpindleState::Off;
-  int selected_tool = 0;         ///< T
-  int tool = 0;                  ///< in the spindle (after M6)
-  int tool_length_offset = 0;    ///< H of G43; 0 when none (G49)
+  int selected_tool = 0;       ///< T
+  int tool = 0;                ///< in the spindle (after M6)
+  int tool_length_offset = 0;  ///< H of G43; 0 when none (G49)
   bool coolant = false;
   std::uint32_t deposition = 0;  ///< bit i: head i's deposition is on
   bool ended = false;            ///< M2/M30 seen
@@ -166,12 +166,22 @@ class Interpreter {
  private:
   struct HeadCode {
     int m = 0;
-    int p = -1;        ///< -1: any (or none)
+    int p = -1;  ///< -1: any (or none)
     int head = 0;
     bool on = false;
   };
-  enum class MRole { None, Stop, OptionalStop, End, SpindleCw, SpindleCcw, SpindleStop, ToolChange, CoolantOn,
-                     CoolantOff };
+  enum class MRole {
+    None,
+    Stop,
+    OptionalStop,
+    End,
+    SpindleCw,
+    SpindleCcw,
+    SpindleStop,
+    ToolChange,
+    CoolantOn,
+    CoolantOff
+  };
 
   MRole role_of(int m) const;
   [[noreturn]] void fail(const Block& b, int column, const std::string& message) const;

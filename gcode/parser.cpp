@@ -88,8 +88,7 @@ void Parser::parse_line(std::string_view text, int line_number, Block& block) co
       break;
     }
     if (c == '%') {
-      if (any_word)
-        fail(line_number, column(p), "found '%' after words; expected '%' alone on its line");
+      if (any_word) fail(line_number, column(p), "found '%' after words; expected '%' alone on its line");
       block.percent = true;
       ++p;
       continue;
@@ -105,11 +104,11 @@ void Parser::parse_line(std::string_view text, int line_number, Block& block) co
       if (c == '/')
         fail(line_number, column(p), "found '/': block delete is not supported; expected a word such as G1");
       fail(line_number, column(p),
-           "found " + shown(c) + "; expected a word (a letter and a number such as X-1.5), a comment in ( ) or "
-                                 "after ;, or the end of the line");
+           "found " + shown(c) +
+               "; expected a word (a letter and a number such as X-1.5), a comment in ( ) or "
+               "after ;, or the end of the line");
     }
-    if (block.percent)
-      fail(line_number, column(p), "found a word on a '%' line; expected '%' alone on its line");
+    if (block.percent) fail(line_number, column(p), "found a word on a '%' line; expected '%' alone on its line");
     const char* word_at = p;
     ++p;
     while (p < end && is_space(*p)) ++p;
@@ -122,10 +121,10 @@ void Parser::parse_line(std::string_view text, int line_number, Block& block) co
       ++p;
     }
     std::uint64_t mantissa = 0;
-    int digits = 0;        // significant digits taken into the mantissa
-    int fraction = 0;      // of which after the point
-    int all_digits = 0;    // every digit seen
-    bool lost = false;     // more significant digits than the fast path holds
+    int digits = 0;      // significant digits taken into the mantissa
+    int fraction = 0;    // of which after the point
+    int all_digits = 0;  // every digit seen
+    bool lost = false;   // more significant digits than the fast path holds
     while (p < end && is_digit(*p)) {
       if (mantissa != 0 || *p != '0') {
         if (digits < kMaxFastDigits) {
@@ -183,15 +182,15 @@ void Parser::parse_line(std::string_view text, int line_number, Block& block) co
       }
       case 'M': {
         if (value < 0 || value != std::nearbyint(value) || value > 99999)
-          fail(line_number, col, "found M" + std::string(number_at, p) + "; expected an M code such as M3 (a whole number)");
+          fail(line_number, col,
+               "found M" + std::string(number_at, p) + "; expected an M code such as M3 (a whole number)");
         if (block.m_count == Block::kMaxCodes)
           fail(line_number, col, "found more than " + std::to_string(Block::kMaxCodes) + " M codes; expected fewer");
         block.m[block.m_count++] = Code{static_cast<int>(value), col};
         break;
       }
       case 'N': {
-        if (any_word)
-          fail(line_number, col, "found an N line number after other words; expected it first on the line");
+        if (any_word) fail(line_number, col, "found an N line number after other words; expected it first on the line");
         if (value < 0 || value != std::nearbyint(value) || value > 99999999)
           fail(line_number, col, "found N" + std::string(number_at, p) + "; expected a line number such as N10");
         block.n = static_cast<int>(value);
@@ -219,8 +218,9 @@ void Parser::parse_line(std::string_view text, int line_number, Block& block) co
     }
     if (block.program_number >= 0 && letter != 'O')
       fail(line_number, col,
-           "found " + std::string(1, letter) + " after an O program number; expected the O number alone on its "
-                                              "line (O words for subroutines are not supported)");
+           "found " + std::string(1, letter) +
+               " after an O program number; expected the O number alone on its "
+               "line (O words for subroutines are not supported)");
     any_word = true;
   }
 }

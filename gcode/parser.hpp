@@ -46,10 +46,10 @@ struct Code {
 struct Block {
   static constexpr int kMaxCodes = 8;  ///< G codes, and M codes, per line
 
-  int line = 0;            ///< 1-based line number in the file
-  bool percent = false;    ///< a `%` line (start or end of a program's text)
-  int n = -1;              ///< the N line number, -1 when absent
-  int program_number = -1; ///< Fanuc `O1000` line: the number, -1 when absent
+  int line = 0;             ///< 1-based line number in the file
+  bool percent = false;     ///< a `%` line (start or end of a program's text)
+  int n = -1;               ///< the N line number, -1 when absent
+  int program_number = -1;  ///< Fanuc `O1000` line: the number, -1 when absent
 
   std::array<Code, kMaxCodes> g{};  ///< G codes in line order, in tenths
   int g_count = 0;

@@ -39,10 +39,14 @@ std::string comment_text(std::string_view s) {
   std::string out;
   out.reserve(s.size());
   for (char c : s) {
-    if (c == '(') c = '[';
-    else if (c == ')') c = ']';
-    else if (c == '\n' || c == '\r' || c == '\t') c = ' ';
-    else if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f) c = '?';
+    if (c == '(')
+      c = '[';
+    else if (c == ')')
+      c = ']';
+    else if (c == '\n' || c == '\r' || c == '\t')
+      c = ' ';
+    else if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f)
+      c = '?';
     out += c;
   }
   return out;
@@ -75,8 +79,8 @@ void require_linuxcnc_codes(const config::Machine& machine) {
       bool ok = false;
       try {
         parser.parse_line(code, 1, b);
-        ok = b.m_count == 1 && b.g_count == 0 && b.m[0].value >= 62 && b.m[0].value <= 65 && b.letters == (1u << ('P' - 'A')) &&
-             b.value('P') >= 0 && b.value('P') == std::floor(b.value('P'));
+        ok = b.m_count == 1 && b.g_count == 0 && b.m[0].value >= 62 && b.m[0].value <= 65 &&
+             b.letters == (1u << ('P' - 'A')) && b.value('P') >= 0 && b.value('P') == std::floor(b.value('P'));
       } catch (const GcodeError&) {
       }
       if (!ok)
@@ -125,8 +129,8 @@ void require_linuxcnc_codes(const config::Machine& machine) {
 
 /// What produced a generated line, for error messages.
 struct Origin {
-  int action = -1;       ///< index into the actions, -1 for the program's header and end
-  int move = -1;         ///< index into the action's moves, -1 for generated lines
+  int action = -1;        ///< index into the actions, -1 for the program's header and end
+  int move = -1;          ///< index into the action's moves, -1 for generated lines
   const char* what = "";  ///< for generated lines: "header", "approach", ...
 };
 
@@ -156,10 +160,9 @@ Instrument resolve_instrument(const ActionProgram& a, const config::Machine& mac
                      (p.tool_number ? "T" + std::to_string(p.tool_number) : "'" + p.instrument + "'") +
                      ", which is not a head of machine '" + machine.name + "'; expected a head's tool_number or name");
   if (p.process == Process::Milling && !in.tool)
-    throw InputError(where + ": milling with " +
-                     (p.tool_number ? "T" + std::to_string(p.tool_number) : "'" + p.instrument + "'") +
-                     ", which is not a cutting tool of machine '" + machine.name +
-                     "'; expected a cutting tool's number or name");
+    throw InputError(
+        where + ": milling with " + (p.tool_number ? "T" + std::to_string(p.tool_number) : "'" + p.instrument + "'") +
+        ", which is not a cutting tool of machine '" + machine.name + "'; expected a cutting tool's number or name");
   return in;
 }
 
@@ -201,7 +204,8 @@ class Writer {
       line("G" + std::to_string(setups.front()->work_offset));
       setup_ = setups.front();
     }
-    for (std::size_t i = 0; i < actions.size(); ++i) action(*actions[i], static_cast<int>(i), instruments[i], *setups[i]);
+    for (std::size_t i = 0; i < actions.size(); ++i)
+      action(*actions[i], static_cast<int>(i), instruments[i], *setups[i]);
     origin_ = {-1, -1, "program end"};
     stop_everything();
     retract_to_top();
@@ -235,7 +239,7 @@ class Writer {
   void comment(std::string_view s) { line("(" + comment_text(s) + ")"); }
   void number(std::string& out, double v) { append_number(out, v, fanuc_); }
 
-  void forget_position() { known_ = false; }
+  void forget_position() { known_[0] = known_[1] = known_[2] = false; }
 
   void retract_to_top() {
     if (retracted_) return;
@@ -304,10 +308,10 @@ class Writer {
         line(s);
       }
       if (stop_for_setup) {
-        const std::string message = "setup " + setup.name + (setup.description.empty() ? "" : ": " + setup.description) +
-                                    " - " + (setup.manual_refixture ? "refixture the part" : "set the part up") +
-                                    " for " + std::string(config::to_string(setup.approach)) +
-                                    ", then cycle start";
+        const std::string message = "setup " + setup.name +
+                                    (setup.description.empty() ? "" : ": " + setup.description) + " - " +
+                                    (setup.manual_refixture ? "refixture the part" : "set the part up") + " for " +
+                                    std::string(config::to_string(setup.approach)) + ", then cycle start";
         comment(fanuc_ ? message : "MSG, " + message);
         line(machine_.gcode.m_codes.program_stop);
       }
@@ -346,7 +350,8 @@ class Writer {
 
     // Approach the start at safe height: up first if the start is higher, then XY, then Z.
     origin_.what = "approach to the path start";
-    if (known_ && p.start.z > position_.z) move(MoveKind::Rapid, Vec3{position_.x, position_.y, p.start.z}, {}, 0, false);
+    if (known_[2] && p.start.z > position_.z)
+      move(MoveKind::Rapid, Vec3{position_.x, position_.y, p.start.z}, {}, 0, false);
     move(MoveKind::Rapid, Vec3{p.start.x, p.start.y, 0.0}, {}, 0, true);
     move(MoveKind::Rapid, p.start, {}, 0, false);
     retracted_ = false;
@@ -390,11 +395,12 @@ class Writer {
       if (xy_only && axis == 2) continue;
       word_.clear();
       number(word_, values[axis]);
-      if (known_ && word_ == last_[axis] && !(arc && axis < 2)) continue;
+      if (known_[axis] && word_ == last_[axis] && !(arc && axis < 2)) continue;
       buffer_ += ' ';
       buffer_ += "XYZ"[axis];
       buffer_ += word_;
       last_[axis] = word_;
+      known_[axis] = true;
       any_axis = true;
     }
     if (arc) {
@@ -416,7 +422,6 @@ class Writer {
       last_feed_ = feed;
     }
     line(buffer_);
-    if (!xy_only) known_ = true;
   }
 
   bool rotary_axes(const config::Setup& setup) const {
@@ -432,8 +437,8 @@ class Writer {
     Vec3 from = a.path.start;
     for (const PathMove& pm : a.path.moves) {
       Motion m;
-      m.kind = pm.kind == MoveKind::Rapid  ? MotionKind::Rapid
-               : pm.kind == MoveKind::Feed ? MotionKind::Feed
+      m.kind = pm.kind == MoveKind::Rapid   ? MotionKind::Rapid
+               : pm.kind == MoveKind::Feed  ? MotionKind::Feed
                : pm.kind == MoveKind::ArcCw ? MotionKind::ArcCw
                                             : MotionKind::ArcCcw;
       m.from_machine = machine_frame(from);
@@ -460,8 +465,8 @@ class Writer {
   bool coolant_on_ = false;
   const config::AdditiveHead* deposition_head_ = nullptr;
   bool retracted_ = false;
-  bool known_ = false;  ///< the last written X, Y, Z are the controller's position
-  Vec3 position_;       ///< work frame
+  bool known_[3] = {false, false, false};  ///< the last written X, Y, Z are the controller's position
+  Vec3 position_;                          ///< work frame
   std::string last_[3];
   double last_feed_ = -1;
   std::string buffer_, word_;

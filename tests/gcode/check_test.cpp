@@ -2,13 +2,14 @@
 // numbers, deposition and spindle misuse, errors collected line by line, and a time
 // estimate that matches hand-computed trapezoids.
 
+#include "gcode/check.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 
 #include "config/machine_loader.hpp"
-#include "gcode/check.hpp"
 
 namespace {
 

@@ -2,6 +2,8 @@
 // coordinates, and the modal mistakes it refuses at line:column, leaving the state as it
 // was so a checker or the simulator can go on.
 
+#include "gcode/interpreter.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,7 +11,6 @@
 
 #include "config/machine_loader.hpp"
 #include "gcode/check.hpp"
-#include "gcode/interpreter.hpp"
 
 namespace {
 
@@ -100,7 +101,7 @@ TEST(Interpreter, MotionModeAndFeedAreModal) {
   ASSERT_EQ(m.size(), 1u);
   EXPECT_EQ(m[0].kind, MotionKind::Feed);
   EXPECT_EQ(m[0].feed, 100.0);
-  EXPECT_EQ(m[0].line, 1);  // run() numbers from 1 again
+  EXPECT_EQ(m[0].line, 1);               // run() numbers from 1 again
   EXPECT_TRUE(run(in, {"G1"}).empty());  // a motion code alone moves nothing
 }
 
@@ -178,8 +179,8 @@ TEST(Interpreter, AFullCircleWithOffsetsAndNotWithR) {
 
 TEST(Interpreter, ArcRadiusMismatchBeyondTolerance) {
   // Start radius 5, end radius 5.01: 0.01 mm apart.
-  expect_error({"G0 X0 Y0 Z5", "G2 X10 Y0 I5.01 F600"}, "t.ngc:2:11: ",
-               "radius to end of arc differs from radius to start");
+  expect_error({"G0 X0 Y0 Z5", "G2 X10 Y0 I5.01 F600"},
+               "t.ngc:2:11: ", "radius to end of arc differs from radius to start");
   // 0.0018 mm apart (and 0.036 %): within LinuxCNC-like tolerances.
   Interpreter in(machine());
   EXPECT_EQ(run(in, {"G0 X0 Y0 Z5", "G2 X10 Y0 I5.0009 F600"}).size(), 1u);
@@ -230,8 +231,9 @@ TEST(Interpreter, WorkOffsetsComeFromTheSetups) {
   EXPECT_EQ(in.state().work_offset, 55);
   m = run(in, {"G54"});
   expect_near(in.state().work_position(), {200, 150, 10});
-  expect_error({"G57"}, "t.ngc:1:1: ", "G57, a work offset no setup of machine 'test' uses; expected one of G54 (top), "
-                                      "G55 (bottom)");
+  expect_error({"G57"}, "t.ngc:1:1: ",
+               "G57, a work offset no setup of machine 'test' uses; expected one of G54 (top), "
+               "G55 (bottom)");
 }
 
 TEST(Interpreter, G53MovesInMachineCoordinatesForOneLine) {
@@ -315,8 +317,8 @@ TEST(Interpreter, DwellAndProgramEnd) {
 }
 
 TEST(Interpreter, TheMachinesOwnMCodes) {
-  const Machine m = hybridctl::config::load_machine(std::string(HYBRIDCTL_SOURCE_DIR) +
-                                                    "/examples/machines/multitask-b-axis.yaml");
+  const Machine m =
+      hybridctl::config::load_machine(std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/multitask-b-axis.yaml");
   Interpreter in(m);
   in.execute_line("T1 M6", 1);
   auto r = in.execute_line("S6000 M203", 2);  // this mill-turn's milling spindle

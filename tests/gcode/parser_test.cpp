@@ -2,14 +2,14 @@
 // numbers, '%' and Fanuc O lines; anything else is an error at FILE:line:column saying
 // what was found and what was expected.
 
+#include "gcode/parser.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
-
-#include "gcode/parser.hpp"
 
 namespace {
 

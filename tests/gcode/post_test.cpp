@@ -4,6 +4,8 @@
 // should), plus the dialects' shapes and the refusal to write anything that would leave
 // the envelope.
 
+#include "gcode/post.hpp"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -16,7 +18,6 @@
 
 #include "config/machine_loader.hpp"
 #include "gcode/interpreter.hpp"
-#include "gcode/post.hpp"
 #include "gcode/tool_table.hpp"
 #include "sample_programs.hpp"
 
@@ -24,8 +25,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace hybridctl::gcode;
-using hybridctl::gcode::samples::sample_actions;
 using hybridctl::config::Machine;
+using hybridctl::gcode::samples::sample_actions;
 
 Machine example(const std::string& name) {
   return hybridctl::config::load_machine(std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/" + name);
@@ -219,7 +220,8 @@ TEST(PostRefusals, AMoveOutsideTheEnvelopeIsRefusedAndNothingIsWritten) {
     FAIL() << "expected a refusal";
   } catch (const hybridctl::InputError& e) {
     const std::string what = e.what();
-    EXPECT_NE(what.find("action 2 (P2, SM-max 10 mm flat rougher @ top), move 4 of 7 (generated line "), std::string::npos)
+    EXPECT_NE(what.find("action 2 (P2, SM-max 10 mm flat rougher @ top), move 4 of 7 (generated line "),
+              std::string::npos)
         << what;
     EXPECT_NE(what.find(": G1 X-250"), std::string::npos) << what;
     EXPECT_NE(what.find("X reaches -50, below the X travel [0, 400]"), std::string::npos) << what;
@@ -246,7 +248,8 @@ TEST(PostRefusals, AnApproachThatLeavesTheEnvelopeNamesTheGeneratedStep) {
     write_program(actions, m);
     FAIL();
   } catch (const hybridctl::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("action 1 (P1, U-AM ded @ top), approach to the path start"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("action 1 (P1, U-AM ded @ top), approach to the path start"),
+              std::string::npos)
         << e.what();
   }
 }

@@ -128,7 +128,7 @@ TEST_F(Rs274, RejectsABrokenProgramNamingTheLine) {
 
   // An arc whose radii differ by 1 mm.
   const Rs274Run arc = rs274(write("tool.tbl", linuxcnc_tool_table(m)),
-                        write("arc.ngc", "G21 G90 G17\nG0 X0 Y0 Z5\nG2 X10 Y0 I4 J0 F100\nM2\n"));
+                             write("arc.ngc", "G21 G90 G17\nG0 X0 Y0 Z5\nG2 X10 Y0 I4 J0 F100\nM2\n"));
   EXPECT_EQ(arc.exit_code, 1);
   EXPECT_NE(arc.err.find("Radius to end of arc differs from radius to start"), std::string::npos) << arc.err;
   EXPECT_NE(arc.err.find("G2 X10 Y0 I4 J0 F100"), std::string::npos) << arc.err;

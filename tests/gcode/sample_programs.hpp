@@ -14,7 +14,9 @@
 namespace hybridctl::gcode::samples {
 
 inline PathMove rapid(double x, double y, double z) { return {MoveKind::Rapid, {x, y, z}, {}, 0, false, ""}; }
-inline PathMove feed(double x, double y, double z, double f, bool on) { return {MoveKind::Feed, {x, y, z}, {}, f, on, ""}; }
+inline PathMove feed(double x, double y, double z, double f, bool on) {
+  return {MoveKind::Feed, {x, y, z}, {}, f, on, ""};
+}
 inline PathMove arc(MoveKind kind, double x, double y, double z, double cx, double cy, double f, bool on) {
   return {kind, {x, y, z}, {cx, cy, 0}, f, on, ""};
 }
