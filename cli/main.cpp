@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   add_inspect_command(app, runner);
   add_plan_command(app, runner);
   add_gcode_command(app, runner);
+  add_export_command(app, runner);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

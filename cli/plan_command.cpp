@@ -2,6 +2,7 @@
 #include <memory>
 
 #include "cli/commands.hpp"
+#include "cli/export_run.hpp"
 #include "cli/progress.hpp"
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
@@ -14,6 +15,8 @@ struct PlanArgs {
   std::string part;
   std::string machine;
   std::string output;
+  std::string export_dir;
+  std::string dialect;
   double voxel = 0;
   double tolerance = -1;
   int top = 0;
@@ -52,9 +55,11 @@ int run_plan(const PlanArgs& args) {
   bar.finish();
   const planner::ReportSources sources{args.part, args.machine, machine.name};
   std::fputs(planner::plan_summary(result, sources).c_str(), stdout);
-  if (!args.output.empty()) {
-    planner::write_plan_directory(result, sources, args.output);
-    std::printf("wrote       %s/plan.json, design.vdb, %zu primitive and %zu plan .vdb files\n", args.output.c_str(),
+  // Export reads the plan back from its directory, as `hybridctl export` does.
+  const std::string plan_dir = !args.output.empty() ? args.output : args.export_dir.empty() ? "" : args.export_dir + "/plan";
+  if (!plan_dir.empty()) {
+    planner::write_plan_directory(result, sources, plan_dir);
+    std::printf("wrote       %s/plan.json, design.vdb, %zu primitive and %zu plan .vdb files\n", plan_dir.c_str(),
                 result.primitives.size(), result.plans.size());
   }
   std::printf("time       ");
@@ -64,6 +69,15 @@ int run_plan(const PlanArgs& args) {
     total += seconds;
   }
   std::printf(" total %.2f s\n", total);
+  if (!args.export_dir.empty() && result.verdict.manufacturable && !result.plans.empty()) {
+    ExportRequest request;
+    request.plan = plan_dir;
+    request.output = args.export_dir;
+    request.dialect = args.dialect;
+    request.machine = args.machine;
+    const int code = export_plan_programs(request);
+    if (code != kSuccess) return code;
+  }
   return result.verdict.manufacturable && !result.plans.empty() ? int(kSuccess) : int(kNotManufacturable);
 }
 
@@ -78,6 +92,10 @@ void add_plan_command(CLI::App& app, Runner& runner) {
   cmd->add_option("-m,--machine", args->machine, "Machine description (YAML)")->required();
   cmd->add_option("-o,--output", args->output,
                   "Write plan.json and .vdb files of the design, primitives and plans into this directory");
+  cmd->add_option("--export", args->export_dir,
+                  "Also write the best plan's G-code into this directory (as `hybridctl export`; the plan goes to "
+                  "-o, or to DIR/plan)");
+  cmd->add_option("--dialect", args->dialect, "With --export: rs274ngc or fanuc (default: the machine file's)");
   cmd->add_option("--voxel", args->voxel, "Voxel size in mm (default: the machine file's planning.voxel_size)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--tolerance", args->tolerance, "Tolerance in mm (default: the machine file's planning.tolerance)")

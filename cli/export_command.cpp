@@ -1,0 +1,87 @@
+// hybridctl export: a plan's actions as G-code programs for the machine.
+
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "cli/commands.hpp"
+#include "cli/export_run.hpp"
+#include "cli/progress.hpp"
+#include "common/error.hpp"
+#include "config/machine_loader.hpp"
+#include "gcode/check.hpp"
+#include "gcode/files.hpp"
+#include "gcode/plan_export.hpp"
+#include "gcode/tool_table.hpp"
+
+namespace hybridctl::cli {
+
+namespace fs = std::filesystem;
+
+int export_plan_programs(const ExportRequest& request) {
+  const planner::PlanFile file = planner::read_plan_file(request.plan);
+  const std::string machine_path = request.machine.empty() ? file.machine_file : request.machine;
+  const config::Machine machine = config::load_machine(machine_path);
+  if (file.plans.empty()) throw InputError(request.plan + ": the plan file holds no plans (the part was not manufacturable)");
+  if (request.rank < 1 || request.rank > int(file.plans.size()))
+    throw InputError("--plan " + std::to_string(request.rank) + ": expected 1.." + std::to_string(file.plans.size()) +
+                     " (the plans in " + request.plan + ")");
+  const planner::PlanFilePlan& plan = file.plans[std::size_t(request.rank - 1)];
+
+  gcode::ExportOptions options;
+  if (!request.dialect.empty()) {
+    if (request.dialect == "rs274ngc" || request.dialect == "linuxcnc") {
+      options.post.dialect = config::Dialect::Rs274ngc;
+    } else if (request.dialect == "fanuc") {
+      options.post.dialect = config::Dialect::Fanuc;
+    } else {
+      throw InputError("--dialect " + request.dialect + ": expected rs274ngc or fanuc");
+    }
+  }
+  const std::string name = "plan-" + std::to_string(request.rank);
+  options.post.program_name = name + " " + plan.expression;
+  ProgressBar bar("toolpaths");
+  options.progress = [&](int action, int actions) { bar.update(double(action - 1) / double(actions)); };
+  const gcode::PlanExport exported = gcode::export_plan(file, plan, machine, options);
+  bar.finish();
+
+  const std::vector<gcode::ActionProgram> programs = exported.programs();
+  if (programs.empty()) throw InputError("plan " + std::to_string(request.rank) + " (" + plan.expression + ") has no action that makes G-code");
+  fs::create_directories(request.output);
+  const gcode::ProgramFiles written = gcode::write_program_files(request.output, name, programs, machine, options.post);
+  gcode::write_text_file(fs::path(request.output) / "tool.tbl", gcode::linuxcnc_tool_table(machine));
+
+  std::printf("plan        %d: %s  cost %.4f\n", request.rank, plan.expression.c_str(), plan.cost);
+  std::size_t next = 0;
+  for (const gcode::ExportedAction& a : exported.actions) {
+    if (!a.makes_gcode) {
+      std::printf("  %d) %-4s %s\n", a.step, a.primitive.c_str(), a.note.c_str());
+      continue;
+    }
+    const fs::path& path = written.actions[next++];
+    const gcode::CheckReport report =
+        gcode::check_program(gcode::read_text_file(path), machine, path.string());
+    std::printf("  %d) %-4s %-44s %9.1f mm³  %6zu moves  %s  -> %s\n", a.step, a.primitive.c_str(),
+                a.program.label.c_str(), a.program.volume, a.program.path.moves.size(),
+                gcode::format_duration(report.time.total).c_str(), path.filename().string().c_str());
+    for (const std::string& w : a.program.path.warnings) std::printf("       warning: %s\n", w.c_str());
+  }
+  std::printf("wrote       %s, %zu action programs and tool.tbl in %s\n", written.program.filename().string().c_str(),
+              written.actions.size(), request.output.c_str());
+  return kSuccess;
+}
+
+void add_export_command(CLI::App& app, Runner& runner) {
+  auto request = std::make_shared<ExportRequest>();
+  auto* cmd = app.add_subcommand("export",
+                                 "Turn a plan's actions into G-code: raster deposition and pocket milling per action, "
+                                 "one program per action plus one for the whole plan, and a LinuxCNC tool table");
+  cmd->add_option("PLAN", request->plan, "plan.json (or its directory) written by `hybridctl plan -o`")->required();
+  cmd->add_option("-o,--output", request->output, "Directory for the programs (created if missing)")->required();
+  cmd->add_option("--plan", request->rank, "Which plan, by rank (1 = cheapest)")->default_val(1)->check(CLI::PositiveNumber);
+  cmd->add_option("--dialect", request->dialect, "rs274ngc (LinuxCNC) or fanuc (default: the machine file's gcode.dialect)");
+  cmd->add_option("-m,--machine", request->machine, "Machine description (default: the file the plan was made with)");
+  cmd->callback([&runner, request] { runner = [request] { return export_plan_programs(*request); }; });
+}
+
+}  // namespace hybridctl::cli

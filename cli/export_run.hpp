@@ -1,0 +1,18 @@
+#pragma once
+// What `hybridctl export` does, shared with `hybridctl plan --export`.
+
+#include <string>
+
+namespace hybridctl::cli {
+
+struct ExportRequest {
+  std::string plan;     // plan.json or its directory
+  std::string output;   // directory for the programs
+  int rank = 1;         // which plan
+  std::string dialect;  // empty: the machine file's
+  std::string machine;  // empty: the file named in plan.json
+};
+
+int export_plan_programs(const ExportRequest& request);
+
+}  // namespace hybridctl::cli

@@ -1,0 +1,178 @@
+#include "planner/plan_file.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "common/error.hpp"
+#include "geometry/vdb_file.hpp"
+
+namespace hybridctl::planner {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// A JSON value with its location, so every error says where.
+class Node {
+ public:
+  Node(const json& j, std::string file, std::string pointer) : j_(j), file_(std::move(file)), pointer_(std::move(pointer)) {}
+
+  [[noreturn]] void fail(const std::string& expected) const {
+    throw InputError(file_ + ": " + (pointer_.empty() ? "/" : pointer_) + ": expected " + expected + ", found " +
+                     (j_.is_null() ? std::string("nothing") : j_.dump().substr(0, 60)));
+  }
+  Node at(const std::string& key) const {
+    if (!j_.is_object()) fail("an object");
+    static const json missing;
+    const auto it = j_.find(key);
+    return Node(it == j_.end() ? missing : *it, file_, pointer_ + "/" + key);
+  }
+  Node at(std::size_t i) const { return Node(j_.at(i), file_, pointer_ + "/" + std::to_string(i)); }
+  bool has(const std::string& key) const { return j_.is_object() && j_.contains(key); }
+  std::size_t size() const {
+    if (!j_.is_array()) fail("an array");
+    return j_.size();
+  }
+  std::string str() const {
+    if (!j_.is_string()) fail("a string");
+    return j_.get<std::string>();
+  }
+  double number() const {
+    if (!j_.is_number()) fail("a number");
+    const double v = j_.get<double>();
+    if (!std::isfinite(v)) fail("a finite number");
+    return v;
+  }
+  int integer() const {
+    if (!j_.is_number_integer()) fail("an integer");
+    const auto v = j_.get<std::int64_t>();
+    if (v < -(1 << 28) || v > (1 << 28)) fail("an integer of at most 2^28 in size");
+    return int(v);
+  }
+  bool boolean() const {
+    if (!j_.is_boolean()) fail("true or false");
+    return j_.get<bool>();
+  }
+  geometry::Index3 index3() const {
+    if (size() != 3) fail("[i, j, k]");
+    return {at(0).integer(), at(1).integer(), at(2).integer()};
+  }
+  geometry::Vec3 vec3() const {
+    if (size() != 3) fail("[x, y, z]");
+    return {at(0).number(), at(1).number(), at(2).number()};
+  }
+
+ private:
+  const json& j_;
+  std::string file_, pointer_;
+};
+
+// A .vdb of the plan on the plan's lattice, clipped to the domain.
+geometry::Solid load_region(const fs::path& directory, const Node& file_node, const geometry::Lattice& lattice,
+                            const geometry::IndexBox& domain) {
+  const std::string relative = file_node.str();
+  if (relative.empty() || fs::path(relative).is_absolute() || relative.find("..") != std::string::npos)
+    file_node.fail("a relative path inside the plan directory");
+  const fs::path path = directory / relative;
+  const geometry::Solid s = geometry::read_vdb(path);
+  const double h = lattice.voxel_size;
+  const auto& o = s.lattice().origin;
+  if (!s.empty() && (std::abs(s.voxel_size() - h) > 1e-9 * h || std::abs(o.x - lattice.origin.x) > 1e-6 * h ||
+                     std::abs(o.y - lattice.origin.y) > 1e-6 * h || std::abs(o.z - lattice.origin.z) > 1e-6 * h))
+    throw InputError(path.string() + ": voxel size " + std::to_string(s.voxel_size()) + " mm; expected the plan's grid (" +
+                     std::to_string(h) + " mm)");
+  if (s.lattice() == lattice) return intersect(s, geometry::Solid::filled(lattice, domain));
+  geometry::Solid out(lattice, domain);  // the same grid up to rounding of the origin
+  s.for_each_voxel([&](geometry::Index3 v) {
+    if (domain.contains(v)) out.set(v);
+  });
+  return out;
+}
+
+}  // namespace
+
+PlanFile read_plan_file(const fs::path& given) {
+  const fs::path json_path = fs::is_directory(given) ? given / "plan.json" : given;
+  const std::string name = json_path.string();
+  std::ifstream in(json_path, std::ios::binary);
+  if (!in) throw InputError(name + ": cannot read: no such file (expected a plan.json written by `hybridctl plan`)");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  json root;
+  try {
+    root = json::parse(buffer.str());
+  } catch (const json::parse_error& e) {
+    throw InputError(name + ": not JSON: " + e.what());
+  }
+  const Node top(root, name, "");
+  if (top.at("format").str() != "hybridctl-plan") top.at("format").fail("\"hybridctl-plan\"");
+  if (top.at("version").integer() != 1) top.at("version").fail("version 1 (this hybridctl reads version 1)");
+
+  PlanFile f;
+  f.directory = json_path.parent_path().empty() ? fs::path(".") : json_path.parent_path();
+  f.part = top.at("part").str();
+  f.machine_name = top.at("machine").at("name").str();
+  f.machine_file = top.at("machine").at("file").str();
+  const Node grid = top.at("grid");
+  f.lattice.voxel_size = grid.at("voxel_size").number();
+  if (f.lattice.voxel_size <= 0) grid.at("voxel_size").fail("a positive voxel size");
+  f.lattice.origin = grid.at("origin").vec3();
+  f.domain = {grid.at("domain").at("lo").index3(), grid.at("domain").at("hi").index3()};
+  if (f.domain.empty()) grid.at("domain").fail("a non-empty box");
+  if (double(f.domain.voxel_count()) > 4e9) grid.at("domain").fail("a domain of at most 4e9 voxels");
+  f.tolerance = top.at("tolerance").number();
+  f.design = load_region(f.directory, top.at("design").at("file"), f.lattice, f.domain);
+
+  const Node prims = top.at("primitives");
+  for (std::size_t i = 0; i < prims.size(); ++i) {
+    const Node p = prims.at(i);
+    PlanFilePrimitive q;
+    q.name = p.at("name").str();
+    q.label = p.at("label").str();
+    q.kind = p.at("kind").str();
+    const std::string mode = p.at("mode").str();
+    if (mode != "additive" && mode != "subtractive") p.at("mode").fail("\"additive\" or \"subtractive\"");
+    q.mode = mode == "additive" ? Mode::Additive : Mode::Subtractive;
+    q.capability = p.at("capability").str();
+    q.setup = p.at("setup").str();
+    if (p.has("tool_number")) q.tool_number = p.at("tool_number").integer();
+    q.region = load_region(f.directory, p.at("file"), f.lattice, f.domain);
+    f.primitives.push_back(std::move(q));
+  }
+  const Node plans = top.at("plans");
+  for (std::size_t k = 0; k < plans.size(); ++k) {
+    const Node p = plans.at(k);
+    PlanFilePlan plan;
+    plan.rank = p.at("rank").integer();
+    plan.expression = p.at("expression").str();
+    plan.cost = p.at("cost").number();
+    const Node actions = p.at("actions");
+    for (std::size_t s = 0; s < actions.size(); ++s) {
+      const Node a = actions.at(s);
+      const std::string prim = a.at("primitive").str();
+      PlanFileAction action;
+      for (std::size_t i = 0; i < f.primitives.size(); ++i)
+        if (f.primitives[i].name == prim) action.primitive = int(i);
+      if (action.primitive < 0) a.at("primitive").fail("the name of one of the plan's primitives");
+      action.volume = a.at("volume").number();
+      action.cost = a.at("cost").number();
+      plan.actions.push_back(action);
+    }
+    f.plans.push_back(std::move(plan));
+  }
+  return f;
+}
+
+std::vector<geometry::Solid> plan_states(const PlanFile& file, const PlanFilePlan& plan) {
+  std::vector<geometry::Solid> states;
+  states.emplace_back(file.lattice, file.domain);
+  for (const PlanFileAction& a : plan.actions) {
+    const PlanFilePrimitive& p = file.primitives[std::size_t(a.primitive)];
+    states.push_back(p.mode == Mode::Additive ? unite(states.back(), p.region) : subtract(states.back(), p.region));
+  }
+  return states;
+}
+
+}  // namespace hybridctl::planner

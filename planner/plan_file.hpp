@@ -1,0 +1,62 @@
+#pragma once
+// Reading back a plan directory written by `hybridctl plan` (docs/plan-format.md): the
+// grid, the design, every primitive's region and the plans' action sequences, enough to
+// replay any plan on the voxels and turn its actions into G-code.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "geometry/solid.hpp"
+#include "planner/search.hpp"
+
+namespace hybridctl::planner {
+
+struct PlanFilePrimitive {
+  std::string name;        // P1, P2, ...
+  std::string label;
+  std::string kind;        // raw-stock, u-am, o-am, sm-max, sm-cons, file
+  Mode mode = Mode::Additive;
+  std::string capability;  // head name, T<n>, stock name or file path
+  std::string setup;       // empty for stocks and files
+  int tool_number = 0;     // cutting tools
+  geometry::Solid region;
+  bool raw_stock() const { return kind == "raw-stock"; }
+};
+
+struct PlanFileAction {
+  int primitive = -1;  // index into PlanFile::primitives
+  double volume = 0;   // mm^3 deposited or removed as planned
+  double cost = 0;     // normalised
+};
+
+struct PlanFilePlan {
+  int rank = 0;
+  std::string expression;
+  double cost = 0;
+  std::vector<PlanFileAction> actions;
+};
+
+struct PlanFile {
+  std::filesystem::path directory;
+  std::string part;
+  std::string machine_name, machine_file;  // machine_file as given when planning
+  geometry::Lattice lattice;
+  geometry::IndexBox domain;
+  double tolerance = 0;
+  geometry::Solid design;
+  std::vector<PlanFilePrimitive> primitives;
+  std::vector<PlanFilePlan> plans;
+};
+
+// Reads DIR/plan.json (or the plan.json given) and the .vdb files it names. Throws
+// hybridctl::InputError naming the file and the JSON location of anything missing,
+// mistyped or inconsistent (unknown version, a plan naming a primitive that does not
+// exist, a .vdb on another grid).
+PlanFile read_plan_file(const std::filesystem::path& plan_json_or_directory);
+
+// The states a plan passes through on the voxels: states[0] is empty, states[k] the
+// material after action k (AM unites, SM subtracts), clipped to the domain.
+std::vector<geometry::Solid> plan_states(const PlanFile& file, const PlanFilePlan& plan);
+
+}  // namespace hybridctl::planner
