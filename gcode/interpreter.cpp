@@ -442,13 +442,22 @@ void Interpreter::run(const Block& b, ModalState& s) {
     }
   }
 
-  // ---- dwell
+  // ---- dwell: RS274NGC G4 P<seconds>; Fanuc G4 X<seconds> or G4 P<milliseconds>
+  std::uint32_t dwell_letters = 0;
   if (dwell.code >= 0) {
-    if (!b.has('P')) fail(b, dwell.column, "found G4 with no P word; expected the dwell time in seconds, e.g. G4 P0.5");
-    const double seconds = b.value('P');
-    if (seconds < 0) fail(b, b.column('P'), "found P" + fmt(seconds) + " with G4; expected a dwell of 0 s or more");
-    used |= bit('P');
-    event(EventKind::Dwell, dwell.column).value = seconds;
+    const bool fanuc = machine_.gcode.dialect == config::Dialect::Fanuc;
+    char letter = 'P';
+    if (fanuc && b.has('X')) letter = 'X';
+    if (!b.has(letter))
+      fail(b, dwell.column,
+           fanuc ? "found G4 with no X or P word; expected the dwell as X<seconds> or P<milliseconds>, e.g. G4 X0.5"
+                 : "found G4 with no P word; expected the dwell time in seconds, e.g. G4 P0.5");
+    const double value = b.value(letter);
+    if (value < 0)
+      fail(b, b.column(letter), "found " + std::string(1, letter) + fmt(value) + " with G4; expected a dwell of 0 or more");
+    dwell_letters = bit(letter);
+    used |= dwell_letters;
+    event(EventKind::Dwell, dwell.column).value = fanuc && letter == 'P' ? value / 1000.0 : value;
   }
 
   // ---- modes
@@ -491,10 +500,10 @@ void Interpreter::run(const Block& b, ModalState& s) {
                  : motion.code == 20 ? MotionKind::ArcCw
                                      : MotionKind::ArcCcw;
   }
-  const std::uint32_t axis_words = b.letters & kAxisLetters;
+  const std::uint32_t axis_words = b.letters & kAxisLetters & ~dwell_letters;
   int first_axis_column = 0;
   for (char L : {'X', 'Y', 'Z', 'A', 'B', 'C'})
-    if (b.has(L) && (first_axis_column == 0 || b.column(L) < first_axis_column)) first_axis_column = b.column(L);
+    if ((axis_words & bit(L)) && (first_axis_column == 0 || b.column(L) < first_axis_column)) first_axis_column = b.column(L);
   if (machine_coords.code >= 0) {
     if (!s.motion_active || (s.motion != MotionKind::Rapid && s.motion != MotionKind::Feed))
       fail(b, machine_coords.column,

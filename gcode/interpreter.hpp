@@ -19,7 +19,8 @@
 // accepted and recorded but do not shift positions: hybridctl's coordinates are those
 // of the tool tip. The start position is the home position (InterpreterOptions::start).
 //
-// What it executes: G0 G1 G2 G3 (I J K centre offsets or R), G4 P (dwell, seconds),
+// What it executes: G0 G1 G2 G3 (I J K centre offsets or R), G4 P (dwell, seconds; Fanuc
+// machines: X seconds or P milliseconds),
 // G17 G18 G19, G20 G21 (inches are converted to mm), G40, G43 H, G49, G53 (with G0/G1),
 // G54..G59, G61 G61.1 G64 (accepted, no effect on the model), G80, G90 G91, G90.1 G91.1,
 // G94; F S T; M0 M1 M2 M30 M3 M4 M5 M6 M7 M8 M9 M62..M65 P, M67/M68 E Q; the machine

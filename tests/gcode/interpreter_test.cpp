@@ -316,6 +316,19 @@ TEST(Interpreter, DwellAndProgramEnd) {
   expect_error({"M30", "G0 X1"}, "t.ngc:2:1: ", "found words after the program end");
 }
 
+TEST(Interpreter, FanucDwellsAreInSecondsWithXAndMillisecondsWithP) {
+  const Machine m = hybridctl::config::load_machine(std::string(HYBRIDCTL_SOURCE_DIR) +
+                                                    "/examples/machines/multitask-b-axis.yaml");
+  Interpreter in(m);
+  auto r = in.execute_line("G4 P1500", 1);
+  ASSERT_EQ(r.events.size(), 1u);
+  EXPECT_EQ(r.events[0].value, 1.5);
+  r = in.execute_line("G4 X2.", 2);
+  ASSERT_EQ(r.events.size(), 1u);
+  EXPECT_EQ(r.events[0].value, 2.0);
+  EXPECT_TRUE(r.motions.empty());  // X is the dwell here, not an axis
+}
+
 TEST(Interpreter, TheMachinesOwnMCodes) {
   const Machine m =
       hybridctl::config::load_machine(std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/multitask-b-axis.yaml");
