@@ -218,6 +218,7 @@ Toolpath deposition_path(const Solid& roi_part, const Solid& existing_part, cons
   const double min_length = options.min_segment_length.value_or(w);
   const double support_gap = options.support_gap.value_or(lh);
   const double reach = options.overhang_reach.value_or(w / 2);
+  const double gap = std::max(0.0, options.approach_gap);
   const double corridor = std::max(w / 2, head.nozzle ? head.nozzle->diameter / 2 : 0.0);
   const std::vector<double> angles = options.raster_angles_deg.empty() ? std::vector<double>{0.0} : options.raster_angles_deg;
 
@@ -234,6 +235,7 @@ Toolpath deposition_path(const Solid& roi_part, const Solid& existing_part, cons
       existing_top.values[i] = face(existing_top_index[i] + 1);
       highest_existing = std::max(highest_existing, existing_top.values[i]);
     }
+  travel_top.values = existing_top.values;
   const double plate_z = options.build_plate_z.value_or(face(material_box.lo.z));
 
   const double z0 = face(roi_box.lo.z), z_top = face(roi_box.hi.z);
@@ -268,9 +270,20 @@ Toolpath deposition_path(const Solid& roi_part, const Solid& existing_part, cons
       }
     return top;
   };
-  auto column_of = [&](Vec2 p) {
-    return std::pair<int, int>{int(std::floor((p.x - lattice.origin.x) / h)),
-                               int(std::floor((p.y - lattice.origin.y) / h))};
+  // The highest material under the bead's footprint at p (columns whose centres lie
+  // within half a bead width): a head whose bead bottom is above it by approach_gap
+  // clears everything a bead there could touch.
+  auto footprint_top = [&](Vec2 p) {
+    const double r = w / 2;
+    const int x0 = int(std::floor((p.x - r - lattice.origin.x) / h)), x1 = int(std::floor((p.x + r - lattice.origin.x) / h));
+    const int y0 = int(std::floor((p.y - r - lattice.origin.y) / h)), y1 = int(std::floor((p.y + r - lattice.origin.y) / h));
+    double top = kNone;
+    for (int y = y0; y <= y1; ++y)
+      for (int x = x0; x <= x1; ++x) {
+        const double cx = lattice.origin.x + (x + 0.5) * h - p.x, cy = lattice.origin.y + (y + 0.5) * h - p.y;
+        if (cx * cx + cy * cy <= r * r + 1e-9) top = std::max(top, travel_top.at(x, y));
+      }
+    return top;
   };
   auto move = [&](MoveKind kind, Vec3 to, double feed, bool on, std::string comment = {}) {
     PathMove m;
@@ -282,30 +295,27 @@ Toolpath deposition_path(const Solid& roi_part, const Solid& existing_part, cons
     path.moves.push_back(std::move(m));
     at = to;
   };
-  // Gets to the start of a pass at height z, lifted over the material on the way.
+  // Gets to the start of a pass at height z, lifted over the material on the way. Near
+  // the work the head moves at feed: out of the bead just laid, and down the last
+  // approach_gap onto the surface (neighbouring beads of the layer stand a bead height
+  // above it); rapids only where the bead could touch nothing.
+  auto clear_height = [&](Vec2 p, double z) { return std::max(z, footprint_top(p) + gap); };
   auto travel_to = [&](Vec2 p, double z) {
-    const auto [cx, cy] = column_of(p);
-    // The surface under the start: the bead may be laid into existing material that
-    // stands above the layer's bottom by a fraction of a layer (the layer and voxel grids
-    // differ); the last bit of that descent is a feed, never a rapid.
-    const double surface = std::max(existing_top.at(cx, cy), deposited_top.at(cx, cy));
-    const double stop = std::max(z, surface);
+    const double stop = std::min(safe_z, clear_height(p, z));
     if (!started) {
       path.start = {p.x, p.y, safe_z};
       move(MoveKind::Rapid, path.start, 0, false, "above the first pass");
       started = true;
     } else {
+      const double out = std::min(safe_z, clear_height({at.x, at.y}, at.z));
+      if (at.z < out) move(MoveKind::Feed, {at.x, at.y, out}, head.feed, false, "up from the bead");
       const double lift =
-          std::min(safe_z, std::max({at.z, z, corridor_top({at.x, at.y}, p)}) + travel);
-      // Out of a surface the bead was laid into, at feed; then rapid.
-      const auto [ax, ay] = column_of({at.x, at.y});
-      const double here = std::max(existing_top.at(ax, ay), deposited_top.at(ax, ay));
-      if (at.z < here) move(MoveKind::Feed, {at.x, at.y, here}, head.feed, false, "out of the surface below");
+          std::min(safe_z, std::max({at.z, stop, z + travel, corridor_top({at.x, at.y}, p) + travel}));
       if (at.z < lift) move(MoveKind::Rapid, {at.x, at.y, lift}, 0, false);
-      move(MoveKind::Rapid, {p.x, p.y, std::max(lift, at.z)}, 0, false);
+      move(MoveKind::Rapid, {p.x, p.y, at.z}, 0, false);
     }
     if (at.z > stop) move(MoveKind::Rapid, {p.x, p.y, stop}, 0, false);
-    if (at.z > z) move(MoveKind::Feed, {p.x, p.y, z}, head.feed, false, "into the surface below");
+    if (at.z > z) move(MoveKind::Feed, {p.x, p.y, z}, head.feed, false, "down onto the surface");
   };
 
   const SliceMask empty_mask(window.lo.x, window.lo.y, window.hi.x - window.lo.x, window.hi.y - window.lo.y);
@@ -354,13 +364,10 @@ Toolpath deposition_path(const Solid& roi_part, const Solid& existing_part, cons
                                 " mm (work frame)");
     }
 
-    // This layer's deposit counts for travels from its first pass on.
+    // This layer's beads count at their full height for travels from its first pass on.
     for (int y = window.lo.y; y < window.hi.y; ++y)
-      for (int x = window.lo.x; x < window.hi.x; ++x) {
-        double& v = travel_top.ref(x, y);
-        v = std::max({v, existing_top.at(x, y), deposited_top.at(x, y)});
-        if (region.at(x, y)) v = std::max(v, zb + head.bead.height);
-      }
+      for (int x = window.lo.x; x < window.hi.x; ++x)
+        if (region.at(x, y)) travel_top.ref(x, y) = std::max(travel_top.at(x, y), zb + head.bead.height);
 
     const double angle = angles[std::size_t(layer) % angles.size()];
     std::vector<Pass> contour, infill;
@@ -398,9 +405,8 @@ Toolpath deposition_path(const Solid& roi_part, const Solid& existing_part, cons
   }
 
   if (started) {
-    const auto [ax, ay] = column_of({at.x, at.y});
-    const double here = std::max(existing_top.at(ax, ay), deposited_top.at(ax, ay));
-    if (at.z < here) move(MoveKind::Feed, {at.x, at.y, here}, head.feed, false, "out of the surface below");
+    const double out = std::min(safe_z, clear_height({at.x, at.y}, at.z));
+    if (at.z < out) move(MoveKind::Feed, {at.x, at.y, out}, head.feed, false, "up from the bead");
     move(MoveKind::Rapid, {at.x, at.y, safe_z}, 0, false, "clear of the part");
   }
   if (warnings_overhang > kMaxWarningsPerKind)

@@ -10,8 +10,9 @@
 // angle that changes from layer to layer, are clipped to the region; deposition is on
 // along the clipped segments only. Between segments the head lifts by travel_clearance
 // above the material under the travel (existing material and everything deposited so
-// far, within the nozzle's radius) and comes down again, with rapids that never descend
-// into material.
+// far, within the nozzle's radius) and comes down again. Rapids never touch material,
+// even with the bead's volume: near the work (approach_gap above the material under the
+// bead) the head moves at feed with deposition off.
 //
 // The programmed point is the bottom of the bead on its axis: the surface the bead is
 // laid on (z = the layer's bottom).
@@ -53,6 +54,10 @@ struct DepositionOptions {
   // a bead may overhang its support by a fraction of its width. Default: half the bead
   // width.
   std::optional<double> overhang_reach;
+  // Rapids stop this far (mm) above the material under the bead's footprint (beads
+  // counted at their full height); the head comes down onto the surface, and leaves a
+  // bead it has just laid, at feed with deposition off.
+  double approach_gap = 0.5;
   // The T number for a head whose tool_number is unset (0, e.g. built by hand); the
   // machine loader always sets it (default 100 + the head's index).
   int fallback_tool_number = 0;

@@ -7,3 +7,5 @@ hybridctl_test(pocket_path_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/pocket_path_te
   LIBS hybridctl_toolpaths hybridctl_planner hybridctl_geometry hybridctl_config)
 hybridctl_test(toolpath_plan_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/toolpath_plan_test.cpp
   LIBS hybridctl_toolpaths hybridctl_planner hybridctl_geometry hybridctl_config)
+hybridctl_test(toolpath_sim_test SOURCES ${CMAKE_CURRENT_LIST_DIR}/toolpath_sim_test.cpp
+  LIBS hybridctl_toolpaths hybridctl_sim hybridctl_geometry hybridctl_config)
