@@ -163,7 +163,12 @@ void Parser::parse_line(std::string_view text, int line_number, Block& block) co
     } else {
       // Rare: more digits than a double holds exactly. from_chars rounds correctly.
       const char* first = number_at + (number_at < end && (*number_at == '+' || *number_at == '-') ? 1 : 0);
-      std::from_chars(first, p, value);
+      value = 0;
+      const auto [stop, error] = std::from_chars(first, p, value);
+      if (error != std::errc() || stop != p || !std::isfinite(value))
+        fail(line_number, column(number_at),
+             "found " + std::string(1, letter) + std::string(number_at, p) +
+                 ", a number out of range; expected a number a double can hold");
     }
     if (negative) value = -value;
     const int col = column(word_at);

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <string>
 
 #include "config/machine_loader.hpp"
@@ -384,6 +385,41 @@ TEST(Interpreter, StreamingLineByLineEqualsTheWholeFile) {
   }
   EXPECT_EQ(whole.motions[2].line, 6);
   EXPECT_EQ(whole.events.back().kind, EventKind::ProgramEnd);
+}
+
+TEST(Interpreter, HostileLinesOnlyEverThrowGcodeError) {
+  // Mutations of valid lines and random bytes: each either runs or is a GcodeError.
+  const std::vector<std::string> seeds = {"G0 X10 Y-2.5 Z3", "G2 X10 Y0 I5 J0 F600", "G3 X1 Y1 R-2 F10",
+                                          "G18 G2 X1 Z1 K1 F5", "T100 M6 M64 P0", "G53 G0 Z300",
+                                          "G20 G91 G1 X1 F1", "M68 E0 Q800", "G4 P1", "G55 G0 X0"};
+  std::mt19937 rng(1234);
+  const std::string alphabet = "GMXYZIJKRFPSTEQHNOABC0123456789.-+ ()%;#/\t\x01\xff";
+  int errors = 0, ran = 0;
+  for (int i = 0; i < 20000; ++i) {
+    std::string line = seeds[rng() % seeds.size()];
+    const int edits = 1 + static_cast<int>(rng() % 4);
+    for (int e = 0; e < edits; ++e) {
+      const std::size_t at = line.empty() ? 0 : rng() % line.size();
+      const char c = alphabet[rng() % alphabet.size()];
+      switch (rng() % 3) {
+        case 0: line.insert(at, 1, c); break;
+        case 1: if (!line.empty()) line.erase(at, 1); break;
+        default: if (!line.empty()) line[at] = c; break;
+      }
+    }
+    if (i % 10 == 0) line = "X" + std::string(400, '9') + "." + std::string(400, '9');  // beyond a double
+    Interpreter in(machine(), "fuzz.ngc");
+    try {
+      in.execute_line("G0 X1 Y1 Z5 F100", 1);
+      in.execute_line(line, 2);
+      ++ran;
+    } catch (const GcodeError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("fuzz.ngc:2:", 0), 0u) << e.what();
+      ++errors;
+    }
+  }
+  EXPECT_GT(errors, 1000);
+  EXPECT_GT(ran, 100);
 }
 
 TEST(Interpreter, HeadCodesTheInterpreterCannotRecogniseAreRefused) {
