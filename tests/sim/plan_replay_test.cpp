@@ -1,0 +1,135 @@
+// The exported programs really make the plan: the bundled bracket is planned on the
+// bundled hybrid machine, each action of a plan is exported to G-code, parsed back by
+// our interpreter and run in the material simulation from the planned state before it;
+// what it leaves must be the planned state after it, within the bounds documented in
+// docs/toolpaths.md ("What a replay may differ by").
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+
+#include "config/machine_loader.hpp"
+#include "gcode/plan_export.hpp"
+#include "geometry/mesh.hpp"
+#include "geometry/morphology.hpp"
+#include "planner/plan_report.hpp"
+#include "sim/replay.hpp"
+
+namespace hybridctl::sim {
+namespace {
+
+namespace fs = std::filesystem;
+using geometry::Solid;
+
+struct Planned {
+  config::Machine machine;
+  planner::PlanFile file;
+};
+
+// Planned once for all tests, at 0.5 mm, and read back from its directory as
+// `hybridctl export` does.
+const Planned& planned() {
+  static const Planned p = [] {
+    Planned out;
+    out.machine = config::load_machine(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
+    const auto mesh = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/bracket.stl");
+    planner::PlanningOptions options;
+    options.voxel_size = 0.5;
+    const planner::PlanningResult r = planner::plan_part(mesh, "bracket.stl", out.machine, options);
+    const fs::path dir = fs::temp_directory_path() / ("hybridctl-replay-" + std::to_string(::getpid()));
+    planner::write_plan_directory(r, {"bracket.stl", "hybrid-3axis.yaml", out.machine.name}, dir);
+    out.file = planner::read_plan_file(dir);
+    fs::remove_all(dir);
+    return out;
+  }();
+  return p;
+}
+
+struct ActionFigures {
+  double roi = 0, missing = 0, extra = 0, worst_extra = 0, worst_missing = 0, gouge = 0;
+  int rapid_incidents = 0, collisions = 0, errors = 0;
+};
+
+// Replays every action of plan `rank` and checks it; returns the figures per action.
+std::vector<ActionFigures> replay_plan(int rank) {
+  const Planned& p = planned();
+  const planner::PlanFilePlan& plan = p.file.plans[std::size_t(rank - 1)];
+  const gcode::PlanExport exported = gcode::export_plan(p.file, plan, p.machine);
+  const Solid core = geometry::erode(p.file.design, geometry::Ball{p.file.tolerance});
+  const double h = p.file.lattice.voxel_size;
+  std::vector<ActionFigures> out;
+  for (const gcode::ExportedAction& a : exported.actions) {
+    if (!a.makes_gcode) continue;
+    const std::string text = gcode::write_action(a.program, p.machine);
+    ReplayOptions options;
+    options.protected_region = core;
+    const ReplayResult r = replay_program(text, p.machine, a.before, options, a.primitive + ".ngc");
+    ActionFigures f;
+    f.roi = a.roi.volume();
+    const Solid missing = subtract(a.after, r.stock), extra = subtract(r.stock, a.after);
+    f.missing = missing.volume();
+    f.extra = extra.volume();
+    f.worst_extra = geometry::farthest_distance(extra, a.after);
+    // Outside the domain is air too: measure depth against a box one voxel wider.
+    geometry::IndexBox wider = a.after.storage_box();
+    wider = {{wider.lo.x - 1, wider.lo.y - 1, wider.lo.z - 1}, {wider.hi.x + 1, wider.hi.y + 1, wider.hi.z + 1}};
+    f.worst_missing = geometry::farthest_distance(missing, complement(a.after, wider));
+    f.gouge = r.report.gouge;
+    for (const Incident& i : r.report.incidents) {
+      f.rapid_incidents += i.kind == IncidentKind::RapidIntoMaterial;
+      f.collisions += i.kind == IncidentKind::BodyCollision;
+    }
+    f.errors = int(r.errors.size());
+    std::printf("plan %d action %d %s %s: roi %.1f mm3, missing %.1f mm3 (worst %.2f mm), extra %.1f mm3 (worst %.2f mm), "
+                "gouge %.1f mm3, %d rapid incidents, %d collisions, %d errors, %d motions\n",
+                rank, a.step, a.primitive.c_str(), a.program.additive ? "deposit" : "remove", f.roi, f.missing,
+                f.worst_missing, f.extra, f.worst_extra, f.gouge, f.rapid_incidents, f.collisions, f.errors, r.motions);
+    for (const Incident& i : r.report.incidents)
+      if (i.kind != IncidentKind::UnsupportedDeposition) std::printf("  %s\n", describe(i).c_str());
+    for (const std::string& e : r.errors) std::printf("  %s\n", e.c_str());
+    // The invariants: nothing of the design beyond the tolerance is cut, no rapid meets
+    // material, the holder never touches, and every line is good G-code.
+    EXPECT_EQ(f.gouge, 0) << a.primitive;
+    EXPECT_EQ(f.rapid_incidents, 0) << a.primitive;
+    EXPECT_EQ(f.collisions, 0) << a.primitive;
+    EXPECT_EQ(f.errors, 0) << a.primitive;
+    // The documented bounds (docs/toolpaths.md, "What a replay may differ by").
+    if (a.program.additive) {
+      const config::AdditiveHead* head = nullptr;
+      for (const auto& hd : p.machine.heads)
+        if (a.program.path.instrument == hd.name) head = &hd;
+      EXPECT_NE(head, nullptr);
+      if (!head) continue;
+      EXPECT_LE(f.extra, 0.10 * f.roi) << a.primitive << ": overfill";
+      EXPECT_LE(f.worst_extra, head->bead.width / 2 + h) << a.primitive << ": overfill depth";
+      // Thin voids between neighbouring tracks and layers (ellipsoid beads).
+      EXPECT_LE(f.missing, 0.02 * f.roi) << a.primitive << ": left empty";
+    } else {
+      EXPECT_EQ(f.missing, 0) << a.primitive << ": the cut took material that must stay";
+      EXPECT_LE(f.extra, 0.25 * f.roi) << a.primitive << ": leftover";
+      EXPECT_LE(f.worst_extra, 2 * h) << a.primitive << ": leftover depth";
+    }
+    out.push_back(f);
+  }
+  return out;
+}
+
+TEST(PlanReplay, TheBestPlanOfTheBracketBuildsWhatItPlans) {
+  const auto figures = replay_plan(1);
+  ASSERT_FALSE(figures.empty());
+}
+
+TEST(PlanReplay, AHybridPlanOfTheBracketBuildsWhatItPlans) {
+  const Planned& p = planned();
+  int rank = 0;
+  for (std::size_t k = 0; k < p.file.plans.size() && !rank; ++k)
+    for (const auto& a : p.file.plans[k].actions)
+      if (p.file.primitives[std::size_t(a.primitive)].mode == planner::Mode::Subtractive) rank = int(k) + 1;
+  ASSERT_GT(rank, 0) << "no plan of the bracket mills";
+  const auto figures = replay_plan(rank);
+  ASSERT_FALSE(figures.empty());
+}
+
+}  // namespace
+}  // namespace hybridctl::sim
