@@ -72,7 +72,7 @@ TEST(MachineExamples, Hybrid3AxisLoads) {
   EXPECT_EQ(m.raw_stocks[0].kind, RawStock::Kind::Box);
   EXPECT_EQ(m.raw_stocks[0].margin[2], 3.0);
   EXPECT_EQ(m.raw_stocks[1].kind, RawStock::Kind::RoundBar);
-  EXPECT_EQ(m.raw_stocks[1].bar_diameter, 80.0);
+  EXPECT_EQ(m.raw_stocks[1].bar_diameter, 90.0);
   EXPECT_EQ(m.raw_stocks[1].bar_axis, Axis::Z);
 
   EXPECT_EQ(m.planning.mode_switch_cost, 50.0);
