@@ -322,9 +322,16 @@ Toolpath deposition_path(const Solid& roi_part, const Solid& existing_part, cons
   for (int layer = 0;; ++layer) {
     const double zb = z0 + layer * lh;
     if (zb >= z_top - 1e-9) break;
-    const int k = int(std::floor((zb + lh / 2 - oz) / h));
-    SliceMask region = slice_of(roi, k, window);
+    // The voxel layers whose centres lie in [zb, zb + lh): every ROI voxel belongs to
+    // exactly one layer. A band thinner than a voxel may hold no centre: it takes the
+    // layer its middle lies in, so no layer of the build is skipped.
+    int k_lo = int(std::ceil((zb - oz) / h - 0.5 - 1e-9));
+    int k_hi = int(std::ceil((zb + lh - oz) / h - 0.5 - 1e-9)) - 1;
+    if (k_hi < k_lo) k_lo = k_hi = int(std::floor((zb + lh / 2 - oz) / h));
+    SliceMask region = slice_of(roi, k_lo, window);
+    for (int kk = k_lo + 1; kk <= k_hi; ++kk) region |= slice_of(roi, kk, window);
     if (region.empty()) continue;
+    const int k = k_hi;
 
     // Columns with existing material above this layer cannot be reached from +Z.
     SliceMask blocked = empty_mask;

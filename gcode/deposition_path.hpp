@@ -6,7 +6,8 @@
 //
 // Work frame (gcode/setup_frame.hpp): the setup's approach direction is +Z. Layers of the
 // head's layer_height go bottom-up from the ROI's lowest voxel face. A layer's region is
-// the ROI's voxel slice at the layer's mid-height. Raster lines at hatch_spacing, at an
+// the ROI's voxels whose centres lie in the layer's band [z, z + layer_height) (the
+// voxel at the band's middle when it holds no centre). Raster lines at hatch_spacing, at an
 // angle that changes from layer to layer, are clipped to the region; deposition is on
 // along the clipped segments only. Between segments the head lifts by travel_clearance
 // above the material under the travel (existing material and everything deposited so

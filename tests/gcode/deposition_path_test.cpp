@@ -51,17 +51,24 @@ config::Setup top_setup() {
 
 Solid box(Box3 b) { return make_box(kLattice, b); }
 
-// The ROI voxel layer a deposition height belongs to: the slice at the layer's mid-height.
-int layer_slice(double z_bottom, double layer_height) {
-  return int(std::floor((z_bottom + layer_height / 2 - kLattice.origin.z) / kLattice.voxel_size));
+// The ROI voxel layers a deposition layer at height z_bottom stands for: those whose
+// centres lie in its band [z_bottom, z_bottom + layer_height).
+std::vector<int> layer_slices(double z_bottom, double layer_height) {
+  const double h = kLattice.voxel_size;
+  std::vector<int> out;
+  for (int k = int(std::floor(z_bottom / h)) - 1; (k + 0.5) * h < z_bottom + layer_height - 1e-9; ++k)
+    if ((k + 0.5) * h >= z_bottom - 1e-9) out.push_back(k);
+  if (out.empty()) out.push_back(int(std::floor((z_bottom + layer_height / 2) / h)));
+  return out;
 }
 
-// Within half a voxel (sideways) of a voxel of `solid` in layer k.
-bool near_slice(const Solid& solid, Vec3 p, int k) {
+// Within half a voxel (sideways) of a voxel of `solid` in one of the layers `ks`.
+bool near_slice(const Solid& solid, Vec3 p, const std::vector<int>& ks) {
   const double h = kLattice.voxel_size;
-  for (double dx : {-h / 2, 0.0, h / 2})
-    for (double dy : {-h / 2, 0.0, h / 2})
-      if (solid.contains({int(std::floor((p.x + dx) / h)), int(std::floor((p.y + dy) / h)), k})) return true;
+  for (int k : ks)
+    for (double dx : {-h / 2, 0.0, h / 2})
+      for (double dy : {-h / 2, 0.0, h / 2})
+        if (solid.contains({int(std::floor((p.x + dx) / h)), int(std::floor((p.y + dy) / h)), k})) return true;
   return false;
 }
 
@@ -82,10 +89,11 @@ void expect_segments_in_region(const Toolpath& p, const Solid& roi, double layer
   int outside = 0;
   for (const Segment& s : segments) {
     ASSERT_DOUBLE_EQ(s.a.z, s.b.z) << "deposition moves are level";
-    const int k = layer_slice(s.a.z, layer_height);
+    const std::vector<int> ks = layer_slices(s.a.z, layer_height);
     along(s.a, s.b, kLattice.voxel_size / 8, [&](Vec3 q) {
-      if (!near_slice(roi, q, k) && ++outside <= 5)
-        ADD_FAILURE() << "deposit at (" << q.x << ", " << q.y << ", " << q.z << ") is outside ROI layer " << k;
+      if (!near_slice(roi, q, ks) && ++outside <= 5)
+        ADD_FAILURE() << "deposit at (" << q.x << ", " << q.y << ", " << q.z << ") is outside the ROI layers "
+                      << ks.front() << ".." << ks.back();
     });
   }
   EXPECT_EQ(outside, 0);
@@ -169,6 +177,22 @@ TEST(DepositionPath, LayersGoBottomUpAtTheLayerHeight) {
   for (std::size_t i = 1; i < layer_z.size(); ++i) EXPECT_NEAR(layer_z[i] - layer_z[i - 1], head.layer_height, 1e-9);
   // 4 mm of ROI at 0.6 mm layers: the layer whose middle is still inside is the last.
   EXPECT_NEAR(layer_z.back(), 1.0 + 6 * 0.6, 1e-9);
+}
+
+TEST(DepositionPath, EveryVoxelLayerOfTheRoiBelongsToADepositionLayer) {
+  // 0.6 mm layers on 0.5 mm voxels: the band [1.2, 1.8) holds the centres of voxel layers
+  // 2 and 3. A flange one voxel thick in layer 2 (z 1.0..1.5) must be deposited with that
+  // band, not lost between the voxel layers the bands' middles fall in.
+  const Solid roi = geometry::unite(box({{4, 4, 0}, {12, 12, 2}}), box({{0, 0, 1}, {16, 16, 1.5}}));
+  const auto head = ded_head();
+  const Toolpath p = deposition_path(roi, Solid(kLattice, {}), head, top_setup());
+  expect_segments_in_region(p, roi, head.layer_height);
+  double flange = 0;  // mm of deposition outside the core's footprint
+  for (const auto& s : deposition_segments(p))
+    along(s.a, s.b, 0.05, [&](Vec3 q) {
+      if (q.x < 3.5 || q.x > 12.5 || q.y < 3.5 || q.y > 12.5) flange += 0.05;
+    });
+  EXPECT_GT(flange, 50);
 }
 
 double direction_deg(const Segment& s) {

@@ -72,13 +72,17 @@ TEST(ToolpathsForAPlan, BracketOnTheHybridMachine) {
       for (std::size_t i = 0; i < p.moves.size(); ++i) {
         if (!p.moves[i].process_on) continue;
         ++segments;
-        const int k = int(std::floor((p.moves[i].to.z + head.layer_height / 2 - r.lattice.origin.z) / h));
+        // The voxel layers whose centres lie in the layer's band.
+        const double zb = p.moves[i].to.z - r.lattice.origin.z;
+        int k_lo = int(std::ceil(zb / h - 0.5 - 1e-9)), k_hi = int(std::ceil((zb + head.layer_height) / h - 0.5 - 1e-9)) - 1;
+        if (k_hi < k_lo) k_lo = k_hi = int(std::floor((zb + head.layer_height / 2) / h));  // a band with no centre
         testing::along(starts[i], p.moves[i].to, h / 8, [&](Vec3 q) {
           bool near = false;
-          for (double dx : {-h / 2, 0.0, h / 2})
-            for (double dy : {-h / 2, 0.0, h / 2})
-              near = near || roi_w.contains({int(std::floor((q.x + dx - r.lattice.origin.x) / h)),
-                                             int(std::floor((q.y + dy - r.lattice.origin.y) / h)), k});
+          for (int k = k_lo; k <= k_hi; ++k)
+            for (double dx : {-h / 2, 0.0, h / 2})
+              for (double dy : {-h / 2, 0.0, h / 2})
+                near = near || roi_w.contains({int(std::floor((q.x + dx - r.lattice.origin.x) / h)),
+                                               int(std::floor((q.y + dy - r.lattice.origin.y) / h)), k});
           outside += near ? 0 : 1;
         });
       }
