@@ -99,13 +99,18 @@ AxialBody guard_body(const std::vector<AxialSection>& sections, double h) {
 
 struct ToolModel {
   std::vector<AxialSection> cutting, body;
-  AxialBody cutter;       // exact cutting part: what is removed
   AxialBody whole_guard;  // cutter + body, conservative: what must not touch `keep`
   AxialBody body_guard;   // body alone, conservative: what must not touch material
   double cutter_radius = 0;
   double max_radius = 0;
   int body_first_level = 0;  // the lowest level the body reaches
   bool widening = true;      // radius never shrinks going up the axis
+  // The cutter as discs: for each distinct radius (voxels), the levels above the tip
+  // that have it, exactly as geometry::offsets_of makes the cutter's voxel offsets.
+  std::vector<std::pair<double, std::vector<int>>> cutter_discs;
+  // The body (shank, holder) as discs: radius (voxels, conservative along the axis as the
+  // guard is) and the lowest level above the tip where it starts.
+  std::vector<std::pair<double, int>> body_discs;
 };
 
 ToolModel make_tool(const config::CuttingTool& tool, double h) {
@@ -129,7 +134,6 @@ ToolModel make_tool(const config::CuttingTool& tool, double h) {
   const double shank_end = flute + tool.shank.length;
   m.body.push_back({AxialSection::Kind::Cylinder, flute, shank_end, tool.shank.diameter / 2, 0, 0});
   m.body.push_back({AxialSection::Kind::Cylinder, shank_end, kInf, tool.holder.diameter / 2, 0, 0});
-  m.cutter = AxialBody{{geometry::Axis::Z, +1}, m.cutting};
   std::vector<AxialSection> whole = m.cutting;
   whole.insert(whole.end(), m.body.begin(), m.body.end());
   m.whole_guard = guard_body(whole, h);
@@ -137,6 +141,21 @@ ToolModel make_tool(const config::CuttingTool& tool, double h) {
   m.cutter_radius = r;
   m.max_radius = std::max({r, tool.shank.diameter / 2, tool.holder.diameter / 2});
   m.body_first_level = int(std::floor(flute / h));
+  for (const AxialSection& g : m.body_guard.sections) {
+    const double radius = g.radius / h;
+    const int from = int(std::lround(std::isinf(g.to) ? g.from / h : (g.from + g.to) / 2 / h));
+    auto it = std::find_if(m.body_discs.begin(), m.body_discs.end(), [&](const auto& d) { return d.first == radius; });
+    if (it == m.body_discs.end()) m.body_discs.push_back({radius, from});
+    else it->second = std::min(it->second, from);
+  }
+  for (int t = 0; t <= int(std::floor(flute / h + 1e-9)); ++t) {
+    const double r2 = profile_sq(m.cutting, t * h);
+    if (r2 < 0) continue;
+    const double radius = std::sqrt(r2) / h;
+    auto it = std::find_if(m.cutter_discs.begin(), m.cutter_discs.end(), [&](const auto& d) { return d.first == radius; });
+    if (it == m.cutter_discs.end()) m.cutter_discs.push_back({radius, {t}});
+    else it->second.push_back(t);
+  }
   double widest = -1;
   for (int i = 0; i <= int(std::ceil((shank_end + h) / h)) * kProfileSamplesPerVoxel; ++i) {
     const double r2 = profile_sq(whole, i * h / kProfileSamplesPerVoxel);
@@ -450,22 +469,30 @@ void PocketBuilder::refresh_tops(const IndexBox& xy) {
 // Removes what the cutter took along the cells visited at level k since the last entry.
 void PocketBuilder::stamp_run(int k) {
   if (run_cells_.empty()) return;
-  int x0 = run_cells_[0].x, x1 = x0, y0 = run_cells_[0].y, y1 = y0;
-  for (const Cell& c : run_cells_) {
+  const std::vector<Cell> cells = run_cells_;
+  int x0 = cells[0].x, x1 = x0, y0 = cells[0].y, y1 = y0;
+  for (const Cell& c : cells) {
     x0 = std::min(x0, c.x), x1 = std::max(x1, c.x), y0 = std::min(y0, c.y), y1 = std::max(y1, c.y);
   }
-  Solid tips(lattice_, {{x0, y0, k}, {x1 + 1, y1 + 1, k + 1}});
-  for (const Cell& c : run_cells_) tips.set({c.x, c.y, k});
   run_cells_.clear();
   air_cache_.clear();
+  // The cutter's discs grown around the tips, level by level above them.
   const int R = int(std::ceil(model_.cutter_radius / h_)) + 1;
-  const IndexBox rb = remaining_.bounding_box();
-  const IndexBox reach{{x0 - R, y0 - R, k}, {x1 + 1 + R, y1 + 1 + R, std::max(k + 1, rb.hi.z)}};
-  const IndexBox domain = geometry::box_intersection(reach, rb);
-  if (domain.empty()) return;
-  const Solid cut = geometry::dilate(tips, model_.cutter, domain);
-  remaining_ = geometry::subtract(remaining_, cut);
-  refresh_tops(domain);
+  SliceMask tips(x0 - R, y0 - R, x1 - x0 + 1 + 2 * R, y1 - y0 + 1 + 2 * R);
+  for (const Cell& c : cells) tips.set(c.x, c.y);
+  const IndexBox storage = remaining_.storage_box();
+  for (const auto& [radius, levels] : model_.cutter_discs) {
+    const SliceMask swept = grow_by_disc(tips, radius);
+    for (int y = swept.y0(); y < swept.y0() + swept.ny(); ++y)
+      for (int x = swept.x0(); x < swept.x0() + swept.nx(); ++x) {
+        if (!swept.at(x, y)) continue;
+        for (const int t : levels) {
+          const geometry::Index3 v{x, y, k + t};
+          if (storage.contains(v) && remaining_.contains(v)) remaining_.set(v, false);
+        }
+      }
+  }
+  refresh_tops({{x0 - R, y0 - R, 0}, {x1 + 1 + R, y1 + 1 + R, 1}});
 }
 
 void PocketBuilder::retract() {
@@ -723,13 +750,33 @@ Toolpath& PocketBuilder::run(const Solid& roi, const Solid& keep, const Solid& s
   const bool alternate = options_.raster == PocketRaster::Alternate;
   int level_number = 0;
   for (const int k : levels) {
-    const IndexBox layer{{work_.lo.x, work_.lo.y, k}, {work_.hi.x, work_.hi.y, k + 1}};
     if (remaining_.empty()) break;
     SliceMask usable = slice_of(allowed, k, work_);
+    // Tips whose shank or holder would meet material still there (material the round
+    // tool left above, out of its reach): each body disc grown around the columns whose
+    // material reaches the disc's lowest level (for the holder, which never ends, exact;
+    // for the shank, conservative).
     const IndexBox now = remaining_.bounding_box();
-    if (now.hi.z - 1 >= k + model_.body_first_level)
-      usable = usable.without(slice_of(geometry::dilate(remaining_, geometry::reflected(model_.body_guard), layer), k, work_));
-    SliceMask useful = slice_of(geometry::dilate(remaining_, geometry::reflected(model_.cutter), layer), k, work_);
+    if (now.hi.z - 1 >= k + model_.body_first_level) {
+      const std::vector<int> top = column_top_indices(remaining_, work_);
+      const int nx = work_.hi.x - work_.lo.x;
+      for (const auto& [radius, from] : model_.body_discs) {
+        SliceMask reached(work_.lo.x, work_.lo.y, nx, work_.hi.y - work_.lo.y);
+        for (int y = work_.lo.y; y < work_.hi.y; ++y)
+          for (int x = work_.lo.x; x < work_.hi.x; ++x)
+            if (top[std::size_t(y - work_.lo.y) * std::size_t(nx) + std::size_t(x - work_.lo.x)] >= k + from)
+              reached.set(x, y);
+        if (!reached.empty()) usable = usable.without(grow_by_disc(reached, radius));
+      }
+    }
+    // Tips whose cutter meets material still there: each disc of the cutter grown
+    // around the material in the layers it reaches.
+    SliceMask useful(work_.lo.x, work_.lo.y, work_.hi.x - work_.lo.x, work_.hi.y - work_.lo.y);
+    for (const auto& [radius, levels] : model_.cutter_discs) {
+      SliceMask material = slice_of(remaining_, k + levels.front(), work_);
+      for (std::size_t i = 1; i < levels.size(); ++i) material |= slice_of(remaining_, k + levels[i], work_);
+      if (!material.empty()) useful |= grow_by_disc(material, radius);
+    }
     useful &= usable;
     if (useful.empty()) continue;
     ++level_number;

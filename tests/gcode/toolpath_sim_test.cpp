@@ -99,7 +99,15 @@ TEST(ToolpathsInTheSimulation, PocketsMillCleanly) {
   bull.type = config::ToolType::Bull;
   bull.corner_radius = 0.75;
   necked.shank = {3, 6};
-  for (const auto& tool : {flat_4mm(), ball, bull, necked}) {
+  // A small cutter on a wide shank (as the bundled 3 mm detail tool): flutes shorter than
+  // the pocket is deep, so the shank goes in, past the corners the cutter leaves.
+  config::CuttingTool detail = flat_4mm();
+  detail.diameter = 2;
+  detail.flute_length = 3;
+  detail.shank = {5, 8};
+  detail.step_down = 1;
+  detail.step_over = 0.8;
+  for (const auto& tool : {flat_4mm(), ball, bull, necked, detail}) {
     SCOPED_TRACE(std::string(config::to_string(tool.type)) + " shank " + std::to_string(tool.shank.diameter));
     expect_clean_milling(stock, roi, keep, tool, top);
   }
