@@ -32,9 +32,11 @@ int main(int argc, char** argv) {
   try {
     return runner ? runner() : kUsage;
   } catch (const hybridctl::InputError& e) {
+    std::fflush(stdout);  // what was printed so far comes before the error
     std::fprintf(stderr, "hybridctl: error: %s\n", e.what());
     return kBadInput;
   } catch (const std::exception& e) {
+    std::fflush(stdout);
     std::fprintf(stderr, "hybridctl: internal error: %s\n", e.what());
     return kInternalError;
   }

@@ -1,4 +1,5 @@
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 
 #include "cli/commands.hpp"
@@ -58,6 +59,7 @@ int run_plan(const PlanArgs& args) {
   // Export reads the plan back from its directory, as `hybridctl export` does.
   const std::string plan_dir = !args.output.empty() ? args.output : args.export_dir.empty() ? "" : args.export_dir + "/plan";
   if (!plan_dir.empty()) {
+    if (args.output.empty()) std::filesystem::create_directories(args.export_dir);
     planner::write_plan_directory(result, sources, plan_dir);
     std::printf("wrote       %s/plan.json, design.vdb, %zu primitive and %zu plan .vdb files\n", plan_dir.c_str(),
                 result.primitives.size(), result.plans.size());
