@@ -684,7 +684,13 @@ Toolpath& PocketBuilder::run(const Solid& roi, const Solid& keep, const Solid& s
   lattice_ = roi.lattice();
   h_ = lattice_.voxel_size;
   model_ = make_tool(tool_, h_);
-  const double step_down = options_.step_down.value_or(tool_.step_down);
+  double step_down = options_.step_down.value_or(tool_.step_down);
+  if (step_down > tool_.flute_length) {
+    // Deeper than the flutes, the shank would have to push through what they leave.
+    path_.warnings.push_back("step down " + mm(step_down) + " mm is more than the flute length; using " +
+                             mm(tool_.flute_length) + " mm");
+    step_down = tool_.flute_length;
+  }
   const double step_over = options_.step_over.value_or(tool_.step_over);
   if (!(step_down > 0) || !(step_over > 0)) throw std::invalid_argument("pocket_path: step_down and step_over must be > 0");
   const int down = std::max(1, int(std::floor(step_down / h_ + 1e-9)));

@@ -116,6 +116,45 @@ TEST(ToolpathsInTheSimulation, PocketsMillCleanly) {
   expect_clean_milling(stock, roi, keep, flat_4mm(), top, rings);
 }
 
+TEST(ToolpathsInTheSimulation, AStepDownDeeperThanTheFlutesIsCutToTheFluteLength) {
+  // 4 mm steps asked of 1.5 mm flutes: levels go no deeper than the flutes reach, so
+  // the shank never has to push through what they leave, and the pocket is cleared.
+  config::Setup top;
+  top.name = "top";
+  const Solid stock = box({{0, 0, 0}, {20, 16, 8}});
+  const Solid roi = box({{4, 4, 0.5}, {16, 12, 8}});
+  const Solid keep = geometry::subtract(stock, roi);
+  config::CuttingTool stubby = flat_4mm();
+  stubby.flute_length = 1.5;
+  stubby.shank = {4, 10};
+  PocketOptions o;
+  o.step_down = 4;
+  const Toolpath p = pocket_path(roi, keep, stock, stubby, top, o);
+  bool warned = false;
+  for (const auto& w : p.warnings) warned = warned || w.find("more than the flute length") != std::string::npos;
+  EXPECT_TRUE(warned);
+  geometry::Vec3 from = p.start;
+  double previous_level = 8;
+  for (const auto& m : p.moves) {
+    if (m.kind == MoveKind::Feed && m.process_on && m.to.z == from.z && m.to.z < previous_level - 1e-9) {
+      EXPECT_LE(previous_level - m.to.z, 1.5 + 0.25 + 1e-9) << "a level deeper than the flutes";
+      previous_level = m.to.z;
+    }
+    from = m.to;
+  }
+  const Solid world = geometry::unite(Solid(kLattice, {{-20, -20, 0}, {60, 52, 60}}), stock);
+  sim::MaterialSimulation s(world, keep);
+  geometry::Vec3 at = p.start;
+  for (std::size_t i = 0; i < p.moves.size(); ++i) {
+    s.cut(sim::cutter_of(stubby), {motion_of(p.moves[i].kind), at, p.moves[i].to, {}, p.moves[i].process_on, int(i + 1)});
+    at = p.moves[i].to;
+  }
+  EXPECT_EQ(count(s.report(), sim::IncidentKind::BodyCollision), 0) << incidents(s.report());
+  EXPECT_EQ(count(s.report(), sim::IncidentKind::RapidIntoMaterial), 0) << incidents(s.report());
+  EXPECT_EQ(count(s.report(), sim::IncidentKind::Gouge), 0) << incidents(s.report());
+  EXPECT_GT(s.report().removed, 0.9 * roi.volume());
+}
+
 TEST(ToolpathsInTheSimulation, SlotsIslandsAndSideSetupsMillCleanly) {
   config::Setup top;
   top.name = "top";
