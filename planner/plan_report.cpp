@@ -112,7 +112,8 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src) {
   doc["search"] = {{"expanded", r.search.expanded},
                    {"generated", r.search.generated},
                    {"exhausted", r.search.exhausted},
-                   {"limit_reached", r.search.limit_reached}};
+                   {"limit_reached", r.search.limit_reached},
+                   {"weight", r.search.weight}};
 
   json plans = json::array();
   for (std::size_t k = 0; k < r.plans.size(); ++k) {
@@ -208,13 +209,21 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
   os << "atoms       " << r.measures.size() << ": " << counts[int(AtomClass::MustIn)] << " must-in, "
      << counts[int(AtomClass::MustOut)] << " must-out, " << counts[int(AtomClass::Free)] << " free (" << slivers
      << " slivers), " << counts[int(AtomClass::Violating)] << " violating\n";
-  os << "verdict     " << (r.verdict.manufacturable ? "manufacturable" : "NOT manufacturable") << ": " << r.verdict.summary
+  os << "verdict     "
+     << (r.verdict.manufacturable ? "manufacturable"
+         : r.search.limit_reached && !r.verdict.decided_without_search ? "UNDECIDED"
+                                                                        : "NOT manufacturable")
+     << ": " << r.verdict.summary
      << "\n";
   const std::size_t shown = std::min<std::size_t>(r.verdict.violations.size(), 10);
   for (std::size_t i = 0; i < shown; ++i) os << "  - " << r.verdict.violations[i].description << "\n";
   if (r.verdict.violations.size() > shown) os << "  ... and " << r.verdict.violations.size() - shown << " more in plan.json\n";
   if (!r.plans.empty()) {
-    os << "plans       " << r.plans.size() << " (A*: " << r.search.expanded << " states expanded)\n";
+    os << "plans       " << r.plans.size() << " (A*: " << r.search.expanded << " states expanded";
+    if (r.search.weight > 1)
+      os << "; the exact search hit its limit, so these come from weighted A* and cost at most " << r.search.weight
+         << "x the optimum";
+    os << ")\n";
     for (std::size_t k = 0; k < r.plans.size(); ++k) {
       const Plan& plan = r.plans[k];
       const Deviation& d = r.deviations[k];

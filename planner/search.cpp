@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <deque>
 #include <functional>
 #include <limits>
 #include <queue>
@@ -152,7 +153,7 @@ std::vector<std::uint64_t> key_of(const Node& n) {
   return k;
 }
 
-Plan plan_from(const std::vector<Node>& nodes, int leaf) {
+Plan plan_from(const std::deque<Node>& nodes, int leaf) {
   Plan plan;
   plan.cost = nodes[std::size_t(leaf)].g;
   plan.final_state = nodes[std::size_t(leaf)].state;
@@ -183,7 +184,7 @@ std::vector<Plan> find_plans(const PlanningProblem& p, const SearchOptions& opti
   const Suppliers sup = suppliers_of(p);
   const int n = int(p.primitives.size());
 
-  std::vector<Node> nodes;
+  std::deque<Node> nodes;  // no reallocation: memory grows by blocks
   nodes.push_back({-1, -1, 0, 0, 0, 0, AtomSet(int(p.atoms.size())), std::vector<std::uint8_t>(std::size_t(n), 0)});
   struct Entry {
     double f, g;
@@ -202,7 +203,8 @@ std::vector<Plan> find_plans(const PlanningProblem& p, const SearchOptions& opti
     st.exhausted = true;
     return plans;
   }
-  open.push({h0, 0, seq++, 0});
+  st.weight = options.weight;
+  open.push({options.weight * h0, 0, seq++, 0});
   std::unordered_map<std::vector<std::uint64_t>, int, KeyHash> pops;
 
   while (!open.empty() && int(plans.size()) < options.top_k) {
@@ -218,7 +220,7 @@ std::vector<Plan> find_plans(const PlanningProblem& p, const SearchOptions& opti
       plans.push_back(plan_from(nodes, id));
       continue;
     }
-    if (st.expanded >= options.max_expansions) {
+    if (st.expanded >= options.max_expansions || std::int64_t(nodes.size()) >= options.max_states) {
       st.limit_reached = true;
       break;
     }
@@ -246,7 +248,7 @@ std::vector<Plan> find_plans(const PlanningProblem& p, const SearchOptions& opti
       ++st.generated;
       nodes.push_back(std::move(child));
       const int child_id = int(nodes.size()) - 1;
-      open.push({nodes.back().g + h, nodes.back().g, seq++, child_id});
+      open.push({nodes.back().g + options.weight * h, nodes.back().g, seq++, child_id});
     }
   }
   if (open.empty() && int(plans.size()) < options.top_k) st.exhausted = true;

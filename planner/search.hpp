@@ -81,11 +81,19 @@ struct SearchStats {
   std::int64_t generated = 0;
   bool exhausted = false;  // the search space ran out before k plans were found
   bool limit_reached = false;
+  double weight = 1.0;  // of the search that produced the plans (1: proven optimal)
 };
 
 struct SearchOptions {
   int top_k = 5;
   std::int64_t max_expansions = 5'000'000;
+  // Memory bound: the search stops (limit_reached) once it holds this many states. At a
+  // few hundred bytes each, the default stays near 1 GB even with thousands of atoms.
+  std::int64_t max_states = 3'000'000;
+  // f = g + weight * h. 1 is A*: plans come cheapest first and the first is optimal. A
+  // weight w > 1 (weighted A*) finds plans faster whose cost is at most w times the
+  // optimum; the planner falls back to it when the exact search hits its limits.
+  double weight = 1.0;
 };
 
 // The k cheapest distinct plans, cheapest first, by A* with an admissible and
