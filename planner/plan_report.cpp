@@ -159,7 +159,11 @@ void write_plan_directory(const PlanningResult& r, const ReportSources& src, con
     }
   }
   const fs::path parent = dir.parent_path().empty() ? fs::path(".") : dir.parent_path();
-  if (!fs::is_directory(parent, ec)) throw InputError(dir.string() + ": cannot write: directory " + parent.string() + " does not exist");
+  // Like mkdir -p: the directories above DIR are made when missing.
+  fs::create_directories(parent, ec);
+  if (!fs::is_directory(parent, ec))
+    throw InputError(dir.string() + ": cannot write: cannot make the directory " + parent.string() +
+                     (ec ? ": " + ec.message() : std::string()));
   // Everything goes into a fresh sibling directory that replaces DIR only when complete.
   const fs::path staging = parent / ("." + dir.filename().string() + ".tmp-" + std::to_string(::getpid()));
   fs::remove_all(staging, ec);

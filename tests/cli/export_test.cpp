@@ -1,0 +1,140 @@
+// hybridctl export as a user runs it: every program exported for the bundled example
+// parts on the LinuxCNC machine passes LinuxCNC's own interpreter (rs274, the real peer
+// unpacked by scripts/setup) and `hybridctl gcode check`; bad requests write nothing.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kSource = HYBRIDCTL_SOURCE_DIR;
+
+struct Outcome {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+class Export : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("hybridctl-export-" + std::to_string(::getpid()) + "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Outcome sh(const std::string& command) {
+    const std::string cmd = command + " >" + quote((dir_ / "stdout").string()) + " 2>" + quote((dir_ / "stderr").string()) + " </dev/null";
+    const int status = std::system(cmd.c_str());
+    Outcome r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.out = slurp(dir_ / "stdout");
+    r.err = slurp(dir_ / "stderr");
+    return r;
+  }
+  Outcome hybridctl(const std::vector<std::string>& args) {
+    std::string cmd = quote(HYBRIDCTL_EXE);
+    for (const auto& a : args) cmd += " " + quote(a);
+    return sh(cmd);
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(Export, EveryProgramForTheExamplePartsPassesRs274AndOurCheck) {
+  ASSERT_TRUE(fs::exists(kSource / ".peers/linuxcnc/usr/bin/rs274"))
+      << "LinuxCNC's rs274 is missing: run scripts/setup (it unpacks linuxcnc-uspace into .peers/linuxcnc)";
+  const std::string machine = (kSource / "examples/machines/hybrid-3axis.yaml").string();
+  for (const std::string part : {"bracket", "thin-wall-slot", "overhang"}) {
+    const fs::path plan = dir_ / part / "plan";
+    const Outcome planned = hybridctl({"plan", (kSource / "examples/parts" / (part + ".stl")).string(), "--machine", machine,
+                                       "--voxel", "0.5", "--top", "3", "-o", plan.string()});
+    ASSERT_EQ(planned.exit_code, 0) << part << "\n" << planned.out << planned.err;
+    int programs = 0;
+    for (int rank = 1; rank <= 3; ++rank) {
+      const fs::path out = dir_ / part / ("plan-" + std::to_string(rank));
+      const Outcome exported = hybridctl({"export", plan.string(), "--plan", std::to_string(rank), "-o", out.string()});
+      ASSERT_EQ(exported.exit_code, 0) << part << " plan " << rank << "\n" << exported.out << exported.err;
+      for (const auto& entry : fs::directory_iterator(out)) {
+        if (entry.path().extension() != ".ngc") continue;
+        ++programs;
+        const Outcome linuxcnc = sh(quote((kSource / "scripts/rs274").string()) + " -t " + quote((out / "tool.tbl").string()) +
+                                    " -g " + quote(entry.path().string()));
+        EXPECT_EQ(linuxcnc.exit_code, 0) << entry.path() << "\n" << linuxcnc.err.substr(0, 2000);
+        const Outcome ours = hybridctl({"gcode", "check", entry.path().string(), "--machine", machine});
+        EXPECT_EQ(ours.exit_code, 0) << entry.path() << "\n" << ours.out.substr(0, 2000) << ours.err;
+      }
+    }
+    EXPECT_GE(programs, 3 * 2) << part << ": a whole program and at least one action program per plan";
+  }
+}
+
+TEST_F(Export, AFanucProgramHasItsMarksAndParsesBack) {
+  const std::string machine = (kSource / "examples/machines/hybrid-3axis.yaml").string();
+  const fs::path plan = dir_ / "plan";
+  ASSERT_EQ(hybridctl({"plan", (kSource / "examples/parts/overhang.stl").string(), "--machine", machine, "--voxel", "0.5",
+                       "--top", "1", "-o", plan.string()})
+                .exit_code,
+            0);
+  const Outcome exported = hybridctl({"export", plan.string(), "--dialect", "fanuc", "-o", (dir_ / "out").string()});
+  ASSERT_EQ(exported.exit_code, 0) << exported.err;
+  const std::string text = slurp(dir_ / "out" / "plan-1.nc");
+  EXPECT_EQ(text.rfind("%\n", 0), 0u);
+  EXPECT_NE(text.find("\nO"), std::string::npos);
+  EXPECT_NE(text.find("\nN10 "), std::string::npos);
+  EXPECT_EQ(text.substr(text.size() - 2), "%\n");
+}
+
+TEST_F(Export, BadRequestsSayWhatWasExpectedAndWriteNothing) {
+  const Outcome missing = hybridctl({"export", (dir_ / "nothing").string(), "-o", (dir_ / "out").string()});
+  EXPECT_EQ(missing.exit_code, 3);
+  EXPECT_NE(missing.err.find("plan.json"), std::string::npos) << missing.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+
+  std::ofstream(dir_ / "plan.json") << R"({"format": "hybridctl-plan", "version": 7})";
+  const Outcome version = hybridctl({"export", (dir_ / "plan.json").string(), "-o", (dir_ / "out").string()});
+  EXPECT_EQ(version.exit_code, 3);
+  EXPECT_NE(version.err.find("/version: expected version 1"), std::string::npos) << version.err;
+
+  std::ofstream(dir_ / "plan.json") << R"({"format": "hybridctl-plan", "version": 1, "part": 3})";
+  const Outcome typed = hybridctl({"export", (dir_ / "plan.json").string(), "-o", (dir_ / "out").string()});
+  EXPECT_EQ(typed.exit_code, 3);
+  EXPECT_NE(typed.err.find("/part: expected a string"), std::string::npos) << typed.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+}
+
+TEST_F(Export, APlanRankBeyondThePlansIsRefused) {
+  const fs::path plan = dir_ / "plan";
+  ASSERT_EQ(hybridctl({"plan", (kSource / "examples/parts/overhang.stl").string(), "--machine",
+                       (kSource / "examples/machines/hybrid-3axis.yaml").string(), "--voxel", "0.5", "--top", "1", "-o",
+                       plan.string()})
+                .exit_code,
+            0);
+  const Outcome r = hybridctl({"export", plan.string(), "--plan", "9", "-o", (dir_ / "out").string()});
+  EXPECT_EQ(r.exit_code, 3);
+  EXPECT_NE(r.err.find("--plan 9: expected 1..1"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+}
+
+}  // namespace
