@@ -10,6 +10,7 @@
 #include <filesystem>
 
 #include "config/machine_loader.hpp"
+#include "gcode/interpreter.hpp"
 #include "gcode/plan_export.hpp"
 #include "geometry/mesh.hpp"
 #include "geometry/morphology.hpp"
@@ -129,6 +130,57 @@ TEST(PlanReplay, AHybridPlanOfTheBracketBuildsWhatItPlans) {
   ASSERT_GT(rank, 0) << "no plan of the bracket mills";
   const auto figures = replay_plan(rank);
   ASSERT_FALSE(figures.empty());
+}
+
+// What the whole program of a hybrid plan does, parsed back: a tool change precedes every
+// spindle start, the spindle runs only with a cutting tool, deposition only with a head,
+// and never both at once.
+TEST(PlanReplay, TheWholeProgramChangesToolsBeforeStartingThem) {
+  const Planned& p = planned();
+  int rank = 0;
+  for (std::size_t k = 0; k < p.file.plans.size() && !rank; ++k)
+    for (const auto& a : p.file.plans[k].actions)
+      if (p.file.primitives[std::size_t(a.primitive)].mode == planner::Mode::Subtractive) rank = int(k) + 1;
+  ASSERT_GT(rank, 0);
+  const gcode::PlanExport exported = gcode::export_plan(p.file, p.file.plans[std::size_t(rank - 1)], p.machine);
+  const std::string text = gcode::write_program(exported.programs(), p.machine);
+  gcode::Interpreter interp(p.machine, "plan.ngc");
+  int line = 0, tool = 0, spindle_starts = 0, depositions = 0;
+  bool spindle = false, depositing = false;
+  std::size_t start = 0;
+  while (start < text.size()) {
+    const std::size_t end = text.find('\n', start);
+    const gcode::LineResult& r = interp.execute_line(std::string_view(text).substr(start, end - start), ++line);
+    start = end == std::string::npos ? text.size() : end + 1;
+    for (const gcode::Event& e : r.events) {
+      switch (e.kind) {
+        case gcode::EventKind::ToolChange:
+          EXPECT_FALSE(spindle) << "line " << line << ": tool change with the spindle running";
+          EXPECT_FALSE(depositing) << "line " << line << ": tool change while depositing";
+          tool = e.tool;
+          break;
+        case gcode::EventKind::SpindleStart:
+          ++spindle_starts;
+          EXPECT_NE(p.machine.find_tool(tool), nullptr) << "line " << line << ": spindle started without a cutting tool";
+          EXPECT_FALSE(depositing) << "line " << line;
+          spindle = true;
+          break;
+        case gcode::EventKind::SpindleStop: spindle = false; break;
+        case gcode::EventKind::DepositionOn:
+          ++depositions;
+          EXPECT_EQ(p.machine.find_tool(tool), nullptr) << "line " << line << ": deposition with a cutter in the spindle";
+          EXPECT_FALSE(spindle) << "line " << line << ": deposition with the spindle running";
+          depositing = true;
+          break;
+        case gcode::EventKind::DepositionOff: depositing = false; break;
+        default: break;
+      }
+    }
+  }
+  EXPECT_GT(spindle_starts, 0);
+  EXPECT_GT(depositions, 0);
+  EXPECT_FALSE(spindle);
+  EXPECT_FALSE(depositing);
 }
 
 }  // namespace
