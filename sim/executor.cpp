@@ -1,0 +1,210 @@
+#include "sim/executor.hpp"
+
+#include <map>
+
+#include "common/error.hpp"
+#include "gcode/check.hpp"
+#include "gcode/setup_frame.hpp"
+#include "sim/instrument.hpp"
+
+namespace hybridctl::sim {
+namespace {
+
+using geometry::IndexBox;
+using geometry::Solid;
+
+// `solid` turned into (or out of) a setup's work frame, stored over the turned `domain`
+// so the simulated world keeps its extent.
+Solid turned(const Solid& solid, const IndexBox& domain, config::Approach approach, bool to_work) {
+  if (approach == config::Approach::PlusZ) return solid;
+  const IndexBox box = to_work ? gcode::part_to_work(domain, solid.lattice(), approach)
+                               : gcode::work_to_part(domain, solid.lattice(), approach);
+  const Solid t = to_work ? gcode::part_to_work(solid, approach) : gcode::work_to_part(solid, approach);
+  Solid out(solid.lattice(), box);
+  t.for_each_voxel([&](geometry::Index3 v) {
+    if (box.contains(v)) out.set(v);
+  });
+  return out;
+}
+
+void add(SimulationReport& total, const SimulationReport& part) {
+  total.moves += part.moves;
+  total.removed += part.removed;
+  total.gouge += part.gouge;
+  total.deposited += part.deposited;
+  total.overlap += part.overlap;
+  total.outside += part.outside;
+  total.collision += part.collision;
+  total.rapid_contact += part.rapid_contact;
+  total.incidents.insert(total.incidents.end(), part.incidents.begin(), part.incidents.end());
+}
+
+}  // namespace
+
+struct ProgramExecutor::Impl {
+  const config::Machine& machine;
+  std::string file_name;
+  ExecutorOptions options;
+  gcode::Interpreter interp;
+  std::map<int, Cutter> cutters;
+  std::map<int, Bead> beads;
+  // The stock lives in the part frame between setups and in the active setup's frame
+  // inside `sim` while motions run there.
+  std::optional<Solid> part_stock;
+  IndexBox domain;
+  const config::Setup* frame = nullptr;
+  std::unique_ptr<MaterialSimulation> sim;
+  SimulationReport finished;  // totals of simulations already left
+  const config::Setup* current = nullptr;
+
+  Impl(const config::Machine& m, std::string name, ExecutorOptions o)
+      : machine(m), file_name(name), options(std::move(o)), interp(m, std::move(name)) {
+    for (const auto& t : m.tools) cutters.emplace(t.number, cutter_of(t));
+    for (std::size_t i = 0; i < m.heads.size(); ++i)
+      beads.emplace(m.heads[i].tool_number > 0 ? m.heads[i].tool_number : int(100 + i), bead_of(m.heads[i]));
+    if (options.stock) {
+      part_stock = *options.stock;
+      domain = part_stock->storage_box();
+    }
+    current = setup_of(54);
+  }
+
+  const config::Setup* setup_of(int offset) const {
+    for (const auto& s : machine.setups)
+      if (s.work_offset == offset) return &s;
+    return nullptr;
+  }
+  void leave_frame() {
+    if (!sim) return;
+    add(finished, sim->report());
+    part_stock = turned(sim->stock(), gcode::part_to_work(domain, part_stock->lattice(), frame->approach), frame->approach,
+                        false);
+    sim.reset();
+  }
+  void enter_frame(const config::Setup* setup) {
+    if (sim && frame == setup) return;
+    leave_frame();
+    frame = setup;
+    std::optional<Solid> guard;
+    if (options.protected_region) guard = turned(*options.protected_region, domain, setup->approach, true);
+    sim = std::make_unique<MaterialSimulation>(turned(*part_stock, domain, setup->approach, true), std::move(guard),
+                                               options.simulation);
+  }
+  bool is_head(int tool) const { return beads.count(tool) > 0; }
+  bool known(int tool) const { return tool == 0 || cutters.count(tool) || beads.count(tool); }
+};
+
+ProgramExecutor::ProgramExecutor(const config::Machine& machine, std::string file_name, ExecutorOptions options)
+    : impl_(std::make_unique<Impl>(machine, std::move(file_name), std::move(options))) {}
+ProgramExecutor::~ProgramExecutor() = default;
+ProgramExecutor::ProgramExecutor(ProgramExecutor&&) noexcept = default;
+ProgramExecutor& ProgramExecutor::operator=(ProgramExecutor&&) noexcept = default;
+
+const gcode::ModalState& ProgramExecutor::state() const { return impl_->interp.state(); }
+
+Solid ProgramExecutor::stock() const {
+  Impl& i = *impl_;
+  if (!i.part_stock) return Solid();
+  if (!i.sim) return *i.part_stock;
+  return turned(i.sim->stock(), gcode::part_to_work(i.domain, i.part_stock->lattice(), i.frame->approach),
+                i.frame->approach, false);
+}
+
+SimulationReport ProgramExecutor::report() const {
+  SimulationReport r = impl_->finished;
+  if (impl_->sim) add(r, impl_->sim->report());
+  return r;
+}
+
+LineOutcome ProgramExecutor::execute_line(std::string_view text, int number) {
+  Impl& i = *impl_;
+  LineOutcome out;
+  const auto where = [&] { return i.file_name + ":" + std::to_string(number) + ": "; };
+  // A line refused by an interlock has set its modal words in the interpreter, but
+  // nothing moved and nothing was cut: the controller stops there.
+  const gcode::ModalState before = i.interp.state();
+  try {
+    const gcode::LineResult& r = i.interp.execute_line(text, number);
+    out.events = r.events;
+    out.motions = r.motions;
+  } catch (const InputError& e) {
+    out.stop = Stop::GcodeError;
+    out.message = e.what();
+    return out;
+  }
+  // Interlocks a controller checks before it moves.
+  int tool = before.tool;
+  bool spindle = before.spindle != gcode::SpindleState::Off, depositing = before.any_deposition();
+  for (const gcode::Event& e : out.events) {
+    if (e.kind == gcode::EventKind::ToolChange) {
+      if (!i.known(e.tool)) {
+        out.stop = Stop::ToolNotInMagazine;
+        out.message = where() + "T" + std::to_string(e.tool) + " is not in the magazine (no such tool or head)";
+        return out;
+      }
+      tool = e.tool;
+    } else if (e.kind == gcode::EventKind::SpindleStart) {
+      spindle = true;
+    } else if (e.kind == gcode::EventKind::SpindleStop) {
+      spindle = false;
+    } else if (e.kind == gcode::EventKind::DepositionOn) {
+      if (!i.is_head(tool)) {
+        out.stop = Stop::DepositionWithoutHead;
+        out.message = where() + "deposition switched on with " +
+                      (tool ? "cutting tool T" + std::to_string(tool) : std::string("no tool")) + " in the spindle";
+        return out;
+      }
+      depositing = true;
+    } else if (e.kind == gcode::EventKind::DepositionOff) {
+      depositing = false;
+    } else if (e.kind == gcode::EventKind::Dwell) {
+      out.seconds += e.value;
+    }
+    if (spindle && depositing) {
+      out.stop = Stop::SpindleDepositionConflict;
+      out.message = where() + "spindle and deposition on at once";
+      return out;
+    }
+  }
+  std::vector<gcode::Motion> done;
+  for (const gcode::Motion& m : out.motions) {
+    if (auto violation = gcode::envelope_violation(m, i.machine.envelope)) {
+      out.stop = Stop::EnvelopeViolation;
+      out.message = where() + *violation;
+      break;
+    }
+    out.seconds += gcode::motion_time(m, i.machine.envelope);
+    done.push_back(m);
+    if (m.work_offset != 53) i.current = i.setup_of(m.work_offset);
+    if (!i.part_stock || !i.current) continue;
+    const auto cutter = i.cutters.find(m.tool);
+    const auto bead = i.beads.find(m.tool);
+    if (cutter == i.cutters.end() && bead == i.beads.end()) continue;  // empty spindle
+    if (m.is_arc() && m.plane != gcode::Plane::XY) continue;  // the material simulation runs XY arcs only
+    i.enter_frame(i.current);
+    const auto& o = i.current->work_origin;
+    auto work = [&](const geometry::Vec3& p) { return geometry::Vec3{p.x - o[0], p.y - o[1], p.z - o[2]}; };
+    MaterialMove move;
+    move.motion = m.kind == gcode::MotionKind::Rapid ? Motion::Rapid
+                  : m.kind == gcode::MotionKind::Feed ? Motion::Linear
+                  : m.kind == gcode::MotionKind::ArcCw ? Motion::ArcCw
+                                                        : Motion::ArcCcw;
+    move.from = work(m.from_machine);
+    move.to = work(m.to_machine);
+    move.centre = work(m.centre_machine);
+    move.process_on = m.deposition;
+    move.line = m.line;
+    const MoveReport r = cutter != i.cutters.end() ? i.sim->cut(cutter->second, move) : i.sim->deposit(bead->second, move);
+    out.incidents.insert(out.incidents.end(), r.incidents.begin(), r.incidents.end());
+    for (const Incident& inc : r.incidents)
+      if (inc.kind == IncidentKind::RapidIntoMaterial && out.stop == Stop::None) {
+        out.stop = Stop::RapidIntoMaterial;
+        out.message = where() + describe(inc);
+      }
+    if (out.stop != Stop::None) break;
+  }
+  out.motions = std::move(done);
+  return out;
+}
+
+}  // namespace hybridctl::sim
