@@ -161,6 +161,9 @@ class Interpreter {
   const LineResult& execute(const Block& block);
 
   const ModalState& state() const { return state_; }
+  /// Puts the modal state back, e.g. to where it was before a line a controller refused
+  /// (an interlock or a soft limit stops the machine before the line's motion).
+  void restore(const ModalState& state) { state_ = state; }
   const config::Machine& machine() const { return machine_; }
   const std::string& file_name() const { return parser_.file_name(); }
 

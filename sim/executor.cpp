@@ -120,9 +120,21 @@ LineOutcome ProgramExecutor::execute_line(std::string_view text, int number) {
   Impl& i = *impl_;
   LineOutcome out;
   const auto where = [&] { return i.file_name + ":" + std::to_string(number) + ": "; };
-  // A line refused by an interlock has set its modal words in the interpreter, but
-  // nothing moved and nothing was cut: the controller stops there.
+  // A line refused by an interlock or a soft limit leaves the machine as it was: the
+  // interpreter's state is put back.
   const gcode::ModalState before = i.interp.state();
+  struct Refuse {
+    Impl& i;
+    const gcode::ModalState& before;
+    LineOutcome& out;
+    LineOutcome& operator()(Stop stop, std::string message) {
+      i.interp.restore(before);
+      out.stop = stop;
+      out.message = std::move(message);
+      out.motions.clear();
+      return out;
+    }
+  } refuse{i, before, out};
   try {
     const gcode::LineResult& r = i.interp.execute_line(text, number);
     out.events = r.events;
@@ -137,42 +149,32 @@ LineOutcome ProgramExecutor::execute_line(std::string_view text, int number) {
   bool spindle = before.spindle != gcode::SpindleState::Off, depositing = before.any_deposition();
   for (const gcode::Event& e : out.events) {
     if (e.kind == gcode::EventKind::ToolChange) {
-      if (!i.known(e.tool)) {
-        out.stop = Stop::ToolNotInMagazine;
-        out.message = where() + "T" + std::to_string(e.tool) + " is not in the magazine (no such tool or head)";
-        return out;
-      }
+      if (!i.known(e.tool))
+        return refuse(Stop::ToolNotInMagazine, where() + "T" + std::to_string(e.tool) + " is not in the magazine (no such tool or head)");
       tool = e.tool;
     } else if (e.kind == gcode::EventKind::SpindleStart) {
       spindle = true;
     } else if (e.kind == gcode::EventKind::SpindleStop) {
       spindle = false;
     } else if (e.kind == gcode::EventKind::DepositionOn) {
-      if (!i.is_head(tool)) {
-        out.stop = Stop::DepositionWithoutHead;
-        out.message = where() + "deposition switched on with " +
-                      (tool ? "cutting tool T" + std::to_string(tool) : std::string("no tool")) + " in the spindle";
-        return out;
-      }
+      if (!i.is_head(tool))
+        return refuse(Stop::DepositionWithoutHead, where() + "deposition switched on with " +
+                                                       (tool ? "cutting tool T" + std::to_string(tool) : std::string("no tool")) +
+                                                       " in the spindle");
       depositing = true;
     } else if (e.kind == gcode::EventKind::DepositionOff) {
       depositing = false;
     } else if (e.kind == gcode::EventKind::Dwell) {
       out.seconds += e.value;
     }
-    if (spindle && depositing) {
-      out.stop = Stop::SpindleDepositionConflict;
-      out.message = where() + "spindle and deposition on at once";
-      return out;
-    }
+    if (spindle && depositing) return refuse(Stop::SpindleDepositionConflict, where() + "spindle and deposition on at once");
   }
+  // Soft limits: checked for the whole line before anything moves.
+  for (const gcode::Motion& m : out.motions)
+    if (auto violation = gcode::envelope_violation(m, i.machine.envelope))
+      return refuse(Stop::EnvelopeViolation, where() + *violation);
   std::vector<gcode::Motion> done;
   for (const gcode::Motion& m : out.motions) {
-    if (auto violation = gcode::envelope_violation(m, i.machine.envelope)) {
-      out.stop = Stop::EnvelopeViolation;
-      out.message = where() + *violation;
-      break;
-    }
     out.seconds += gcode::motion_time(m, i.machine.envelope);
     done.push_back(m);
     if (m.work_offset != 53) i.current = i.setup_of(m.work_offset);

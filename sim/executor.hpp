@@ -59,9 +59,9 @@ class ProgramExecutor {
   ProgramExecutor(ProgramExecutor&&) noexcept;
   ProgramExecutor& operator=(ProgramExecutor&&) noexcept;
 
-  // Executes one line. A G-code error leaves the machine as it was (stop GcodeError); an
-  // interlock (tool, deposition, spindle) stops before any motion of the line; an
-  // envelope violation stops before the offending motion.
+  // Executes one line. A line that is not valid G-code, trips an interlock (tool,
+  // deposition, spindle) or would leave the envelope is refused whole: the machine stays
+  // as it was before it.
   LineOutcome execute_line(std::string_view text, int number);
 
   const gcode::ModalState& state() const;
