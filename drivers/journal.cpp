@@ -1,0 +1,170 @@
+#include "drivers/journal.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "common/error.hpp"
+
+namespace hybridctl::drivers {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr const char* kFileName = "journal.jsonl";
+
+double seconds_now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+std::string hex64(std::uint64_t v) {
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+}  // namespace
+
+Journal::Journal(fs::path path, int fd, JournalHeader header, JournalProgress progress)
+    : path_(std::move(path)), fd_(fd), last_sync_(seconds_now()), header_(std::move(header)), progress_(progress) {}
+
+Journal::Journal(Journal&& o) noexcept
+    : sync_period_s(o.sync_period_s), path_(std::move(o.path_)), fd_(o.fd_), last_sync_(o.last_sync_),
+      header_(std::move(o.header_)), progress_(o.progress_) {
+  o.fd_ = -1;
+}
+
+Journal& Journal::operator=(Journal&& o) noexcept {
+  if (this != &o) {
+    if (fd_ >= 0) ::close(fd_);
+    sync_period_s = o.sync_period_s;
+    path_ = std::move(o.path_);
+    fd_ = o.fd_;
+    last_sync_ = o.last_sync_;
+    header_ = std::move(o.header_);
+    progress_ = o.progress_;
+    o.fd_ = -1;
+  }
+  return *this;
+}
+
+Journal::~Journal() {
+  if (fd_ >= 0) {
+    ::fsync(fd_);
+    ::close(fd_);
+  }
+}
+
+Journal Journal::create(const fs::path& directory, const JournalHeader& header) {
+  std::error_code ec;
+  fs::create_directories(directory, ec);
+  if (!fs::is_directory(directory)) throw InputError(directory.string() + ": cannot make the job directory");
+  const fs::path path = directory / kFileName;
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_APPEND | O_CLOEXEC, 0644);
+  if (fd < 0)
+    throw InputError(path.string() + ": cannot start a journal: " + std::strerror(errno) +
+                     (errno == EEXIST ? " (a job directory holds one job: resume it with --resume, or choose another)" : ""));
+  Journal j(path, fd, header, {});
+  const json h = {{"journal", "hybridctl-job"}, {"version", 1},          {"program", header.program},
+                  {"identity", hex64(header.identity)},                  {"lines", header.lines},
+                  {"machine", header.machine}, {"transport", header.transport}, {"source", header.source}};
+  j.append(h.dump(), true);
+  // The directory entry too, so the file survives a crash right after creation.
+  const int dfd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    ::fsync(dfd);
+    ::close(dfd);
+  }
+  return j;
+}
+
+Journal Journal::open(const fs::path& directory) {
+  const fs::path path = directory / kFileName;
+  std::ifstream in(path);
+  if (!in) throw InputError(path.string() + ": no journal here (expected the --job directory of an earlier run)");
+  JournalHeader header;
+  JournalProgress progress;
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    const std::string where = path.string() + ":" + std::to_string(number) + ": ";
+    json j;
+    try {
+      j = json::parse(line);
+    } catch (const json::parse_error&) {
+      // The last line may be torn by a crash mid-write: anything before it is whole.
+      if (in.peek() == EOF) break;
+      throw InputError(where + "not a JSON object; expected a journal line written by hybridctl run");
+    }
+    try {
+      if (number == 1) {
+        if (j.value("journal", "") != "hybridctl-job" || j.value("version", 0) != 1)
+          throw InputError(where + "expected a hybridctl job journal, version 1");
+        header.program = j.at("program").get<std::string>();
+        header.identity = std::stoull(j.at("identity").get<std::string>(), nullptr, 16);
+        header.lines = j.at("lines").get<std::uint32_t>();
+        header.machine = j.at("machine").get<std::string>();
+        header.transport = j.at("transport").get<std::string>();
+        header.source = j.value("source", "");
+      } else if (j.contains("chunk")) {
+        progress.last_chunk = j.at("chunk").get<std::uint32_t>();
+        progress.through_line = j.at("through_line").get<std::uint32_t>();
+        progress.executed_line = j.at("executed_line").get<std::uint32_t>();
+      } else if (j.contains("completed")) {
+        progress.completed = true;
+        progress.executed_line = j.at("completed").get<std::uint32_t>();
+      }
+    } catch (const InputError&) {
+      throw;
+    } catch (const std::exception& e) {
+      throw InputError(where + "malformed journal entry: " + e.what());
+    }
+  }
+  if (number == 0) throw InputError(path.string() + ": empty journal; expected a header line");
+  const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+  if (fd < 0) throw InputError(path.string() + ": cannot append: " + std::strerror(errno));
+  return Journal(path, fd, header, progress);
+}
+
+void Journal::append(const std::string& line, bool sync) {
+  const std::string text = line + "\n";
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd_, text.data() + done, text.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throw std::runtime_error(path_.string() + ": cannot write the journal: " + std::strerror(errno));
+    }
+    done += std::size_t(n);
+  }
+  if (sync) {
+    ::fsync(fd_);
+    last_sync_ = seconds_now();
+  }
+}
+
+void Journal::acknowledged(std::uint32_t chunk, std::uint32_t through_line, std::uint32_t executed_line) {
+  progress_.last_chunk = chunk;
+  progress_.through_line = through_line;
+  progress_.executed_line = executed_line;
+  const json j = {{"chunk", chunk}, {"through_line", through_line}, {"executed_line", executed_line}};
+  append(j.dump(), seconds_now() - last_sync_ >= sync_period_s);
+}
+
+void Journal::note(const std::string& event) { append(json{{"note", event}}.dump(), false); }
+
+void Journal::completed(std::uint32_t executed_line) {
+  progress_.completed = true;
+  progress_.executed_line = executed_line;
+  append(json{{"completed", executed_line}}.dump(), true);
+}
+
+}  // namespace hybridctl::drivers

@@ -1,0 +1,256 @@
+#include "drivers/streamer.hpp"
+
+#include <chrono>
+#include <thread>
+
+#include "common/error.hpp"
+#include "drivers/journal.hpp"
+#include "drivers/protocol/chunk.hpp"
+#include "drivers/protocol/chunk_acceptor.hpp"
+
+namespace hybridctl::drivers {
+namespace {
+
+using protocol::AlarmCode;
+using protocol::CommandCode;
+using protocol::ControllerState;
+using protocol::ResultCode;
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+std::string hex64(std::uint64_t v) {
+  char buf[19];
+  std::snprintf(buf, sizeof buf, "0x%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+// Alarms the program itself caused: no operator action makes resuming right.
+bool program_fault(AlarmCode a) {
+  return a == AlarmCode::EnvelopeViolation || a == AlarmCode::RapidIntoMaterial || a == AlarmCode::DepositionWithoutHead ||
+         a == AlarmCode::GcodeError || a == AlarmCode::SpindleDepositionConflict || a == AlarmCode::ProgramIdentityMismatch;
+}
+
+class Session {
+ public:
+  Session(Transport& t, std::span<const std::string> lines, const StreamOptions& o, const StreamCallbacks& cb, Journal* j)
+      : t_(t), lines_(lines), options_(o), cb_(cb), journal_(j), identity_(protocol::program_identity(lines)) {}
+
+  StreamResult run() {
+    status_ = t_.read_status();
+    boot_ = status_.boot_count;
+    seq_ = status_.command_seq;
+    open_program();
+    last_heartbeat_ = Clock::now() - std::chrono::seconds(1);
+    while (true) {
+      heartbeat();
+      fill();
+      if (decide()) break;
+    }
+    result_.final_status = status_;
+    if (journal_ && result_.completed) journal_->completed(status_.last_executed_line);
+    return result_;
+  }
+
+ private:
+  void note(const std::string& s) {
+    if (cb_.note) cb_.note(s);
+    if (journal_) journal_->note(s);
+  }
+  void seen(const protocol::Status& s) {
+    status_ = s;
+    if (cb_.status) cb_.status(s);
+    if (s.boot_count != boot_) {
+      boot_ = s.boot_count;
+      ++result_.counters.reboots_seen;
+      seq_ = s.command_seq;  // the controller forgot the last seq
+      note("controller restarted (boot " + std::to_string(s.boot_count) + "): its buffer was lost; resending from line " +
+           std::to_string(s.next_line) + " (the safe point after line " + std::to_string(s.last_executed_line) + ")");
+    }
+  }
+  protocol::Status command(CommandCode code) {
+    protocol::Command c{code, seq_ = protocol::next_command_seq(seq_), 0, 0};
+    if (code == CommandCode::SetProgram) {
+      c.identity = identity_;
+      c.line_count = std::uint32_t(lines_.size());
+    }
+    seen(t_.send_command(c));
+    // A reply lost on the way may leave the status behind the command: read until it shows.
+    for (int i = 0; i < 50 && status_.command_seq != c.seq; ++i) seen(t_.read_status());
+    if (status_.command_seq == c.seq && status_.command_result != ResultCode::Accepted)
+      note(std::string(protocol::to_string(code)) + " refused: " + std::string(protocol::to_string(status_.command_result)));
+    return status_;
+  }
+
+  void open_program() {
+    const bool ours = status_.identity == identity_;
+    const ControllerState st = status_.state;
+    const bool free = st == ControllerState::Idle || st == ControllerState::Completed || st == ControllerState::Aborted;
+    if (options_.resume) {
+      if (!ours)
+        throw InputError("the controller holds program " + hex64(status_.identity) + ", not this job's " + hex64(identity_) +
+                         ": refusing to resume into another program");
+      note("resuming: the controller executed through line " + std::to_string(status_.last_executed_line) + " of " +
+           std::to_string(lines_.size()) + ", state " + std::string(protocol::to_string(st)));
+      started_ = st != ControllerState::Idle;
+      return;
+    }
+    if (ours && !free) {
+      // Our own program, interrupted (a host restart without --resume): carry on.
+      note("the controller is already running this program: continuing at line " + std::to_string(status_.next_line));
+      started_ = true;
+      return;
+    }
+    if (!free)
+      throw InputError("the controller is busy with program " + hex64(status_.identity) + " (state " +
+                       std::string(protocol::to_string(st)) + "): refusing to mix programs; wait for it or ABORT it");
+    command(CommandCode::SetProgram);
+    if (status_.identity != identity_)
+      throw InputError("the controller did not take the program: " + std::string(protocol::to_string(status_.command_result)));
+  }
+
+  void heartbeat() {
+    if (since(last_heartbeat_) < options_.heartbeat_period_s) return;
+    t_.send_heartbeat(++heartbeat_);
+    last_heartbeat_ = Clock::now();
+  }
+
+  // Sends chunks while the controller has room; the status after each says what next.
+  void fill() {
+    const std::size_t max = t_.max_chunk_payload();
+    for (int sent = 0; sent < 64; ++sent) {
+      if (status_.identity != identity_ || !protocol::accepts_chunks(status_.state)) return;
+      const std::uint32_t line = status_.next_line;
+      if (line == 0 || line > lines_.size()) return;
+      const std::size_t room = std::min<std::size_t>(max, status_.free_buffer_bytes);
+      if (room < 2) return;
+      auto chunk = protocol::make_chunk(lines_, line, status_.last_accepted_chunk + 1, identity_, room);
+      if (!chunk.ok()) {
+        // The next line does not fit in the free space yet (or at all: a program error).
+        if (chunk.error().code == ResultCode::TooLong && room < max) return;
+        throw InputError("line " + std::to_string(line) + ": " + chunk.error().message);
+      }
+      const protocol::Chunk& c = chunk.value();
+      ++result_.counters.chunks_sent;
+      seen(t_.send_chunk(c));
+      const bool ours_written = status_.last_written_chunk == c.seq;
+      const ResultCode r = ours_written ? status_.chunk_result : ResultCode::None;
+      if (r == ResultCode::Accepted) {
+        ++result_.counters.chunks_accepted;
+        if (journal_) journal_->acknowledged(c.seq, c.first_line + c.line_count - 1, status_.last_executed_line);
+      } else if (r == ResultCode::Duplicate) {
+        ++result_.counters.duplicates;
+      } else if (r == ResultCode::BufferFull) {
+        return;
+      } else {
+        ++result_.counters.refused;
+        return;  // the status has the truth; the next round starts from it
+      }
+    }
+  }
+
+  // Follows the controller's state; true when the stream is over.
+  bool decide() {
+    if (status_.identity != identity_) {
+      // The controller lost the program (a reboot without a started program): set it again.
+      if (status_.identity == 0 && status_.state == ControllerState::Idle) {
+        command(CommandCode::SetProgram);
+        return false;
+      }
+      result_.stopped_because = "the controller now holds another program (" + hex64(status_.identity) + ")";
+      return true;
+    }
+    switch (status_.state) {
+      case ControllerState::Completed:
+        result_.completed = true;
+        return true;
+      case ControllerState::Aborted:
+        result_.stopped_because = "the program was aborted";
+        return true;
+      case ControllerState::Idle:
+        if (!started_ && status_.last_accepted_chunk > 0) {
+          command(CommandCode::Start);
+          started_ = true;
+          return false;
+        }
+        break;
+      case ControllerState::ProgramStop:
+      case ControllerState::OptionalStop:
+        if (cb_.program_stop && cb_.program_stop(status_)) {
+          command(CommandCode::OperatorAck);
+          return false;
+        }
+        result_.stopped_because = "stopped at the program stop after line " + std::to_string(status_.last_executed_line);
+        return true;
+      case ControllerState::Alarm: {
+        const AlarmCode a = status_.alarm;
+        const auto& info = protocol::alarm_info(a);
+        if (!program_fault(a) && cb_.recover && cb_.recover(status_)) {
+          ++result_.counters.recoveries;
+          note(std::string("alarm ") + std::string(info.name) + ": clearing it (RESET_ALARM) and resuming");
+          command(CommandCode::ResetAlarm);
+          held_by_us_ = true;
+          return false;
+        }
+        result_.stopped_because = std::string("alarm ") + std::string(info.name) +
+                                  (status_.alarm_line ? " at line " + std::to_string(status_.alarm_line) : std::string()) +
+                                  ": " + std::string(info.meaning) + " " + std::string(info.action);
+        return true;
+      }
+      case ControllerState::FeedHold:
+        if (held_by_us_) {
+          // After RESET_ALARM: once the buffer is refilled from the safe point, go on.
+          if (status_.last_accepted_chunk > status_.last_executed_chunk || status_.next_line > lines_.size()) {
+            command(CommandCode::Resume);
+            held_by_us_ = false;
+          }
+          return false;
+        }
+        if (host_hold_) {
+          if (cb_.resume_after_hold && cb_.resume_after_hold(status_)) {
+            command(CommandCode::Resume);
+            host_hold_ = false;
+          } else {
+            command(CommandCode::Abort);
+          }
+          return false;
+        }
+        break;
+      case ControllerState::Running:
+        if (cb_.hold_requested && cb_.hold_requested()) {
+          command(CommandCode::FeedHold);
+          host_hold_ = true;
+          return false;
+        }
+        break;
+    }
+    // Nothing to do but wait: read the status again.
+    const bool room = status_.next_line <= lines_.size() && status_.free_buffer_bytes >= t_.max_chunk_payload();
+    if (!room) std::this_thread::sleep_for(std::chrono::duration<double>(options_.poll_period_s));
+    seen(t_.read_status());
+    return false;
+  }
+
+  Transport& t_;
+  std::span<const std::string> lines_;
+  const StreamOptions& options_;
+  const StreamCallbacks& cb_;
+  Journal* journal_;
+  std::uint64_t identity_;
+  protocol::Status status_;
+  std::uint16_t boot_ = 0, seq_ = 0, heartbeat_ = 0;
+  Clock::time_point last_heartbeat_;
+  bool started_ = false, held_by_us_ = false, host_hold_ = false;
+  StreamResult result_;
+};
+
+}  // namespace
+
+StreamResult stream_program(Transport& transport, std::span<const std::string> lines, const StreamOptions& options,
+                            const StreamCallbacks& callbacks, Journal* journal) {
+  if (lines.empty()) throw InputError("the program is empty: nothing to stream");
+  Session session(transport, lines, options, callbacks, journal);
+  return session.run();
+}
+
+}  // namespace hybridctl::drivers

@@ -1,0 +1,74 @@
+#pragma once
+// Streaming one program to a controller, exactly once (docs/protocol.md, "Host
+// procedures"): set the program (or find it there and resume), keep the controller's
+// buffer full from its free-space report with as many whole lines per chunk as fit, send
+// each chunk and read the status in one request where the transport allows, keep the
+// heartbeat, and follow the controller through stops, alarms, reconnects and reboots.
+//
+// The controller's status is the truth: the next chunk is always number
+// last_accepted_chunk + 1 starting at next_line, so after a reconnect, a host restart or
+// a controller reboot nothing is skipped and nothing runs twice.
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "drivers/protocol/messages.hpp"
+#include "drivers/transport.hpp"
+
+namespace hybridctl::drivers {
+
+class Journal;
+
+// What the streamer asks of its user when the program needs a decision.
+struct StreamCallbacks {
+  // Every status read (for a live status line).
+  std::function<void(const protocol::Status&)> status;
+  // Something worth a line in the log ("controller restarted: resuming at line 812").
+  std::function<void(const std::string&)> note;
+  // The program stopped at M0/M1 (the operator message is in the program text before
+  // the line): true to continue (OPERATOR_ACK), false to stop streaming here.
+  std::function<bool(const protocol::Status&)> program_stop;
+  // An alarm the operator may clear (controller restarted, heartbeat lost): true to send
+  // RESET_ALARM and RESUME. Alarms caused by the program itself always end the stream.
+  std::function<bool(const protocol::Status&)> recover;
+  // Polled between requests: true to hold (FEED_HOLD) — e.g. after Ctrl-C.
+  std::function<bool()> hold_requested;
+  // While held at the host's request: true to resume, false to abort.
+  std::function<bool(const protocol::Status&)> resume_after_hold;
+};
+
+struct StreamOptions {
+  double heartbeat_period_s = 0.2;  // the protocol asks for at most 0.25 s
+  double poll_period_s = 0.002;     // status polling when there is nothing to send
+  // Resume: the controller must hold this very program (its identity); never SET_PROGRAM.
+  bool resume = false;
+};
+
+struct StreamCounters {
+  std::uint64_t chunks_sent = 0;     // chunk writes, all results
+  std::uint64_t chunks_accepted = 0;
+  std::uint64_t duplicates = 0;      // the controller already had it (a lost reply)
+  std::uint64_t refused = 0;         // gap, line mismatch, buffer full ...: recomputed from the status
+  std::uint64_t transport_errors = 0;
+  std::uint64_t reboots_seen = 0;
+  std::uint64_t recoveries = 0;      // alarms cleared with RESET_ALARM + RESUME
+};
+
+struct StreamResult {
+  bool completed = false;
+  protocol::Status final_status;
+  std::string stopped_because;  // when not completed: the alarm or the decision that ended it
+  StreamCounters counters;
+};
+
+// Streams `lines` (the program as protocol::program_lines splits it). Throws
+// TransportError when the controller cannot be reached any more (the journal lets a later
+// run resume), InputError when the controller holds another program and `resume` asks
+// for this one, or it is busy with another program.
+StreamResult stream_program(Transport& transport, std::span<const std::string> lines, const StreamOptions& options,
+                            const StreamCallbacks& callbacks, Journal* journal = nullptr);
+
+}  // namespace hybridctl::drivers
