@@ -190,6 +190,7 @@ struct Controller::Impl {
     ++next_in_chunk;
     last_executed_line = number;
     executed.push_back(number);
+    if (options.on_line_executed) options.on_line_executed(number, text);
     if (next_in_chunk >= chunk_lines.size()) {
       last_executed_chunk = chunk->seq;
       ++chunks_executed;

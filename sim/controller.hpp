@@ -15,6 +15,8 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
+#include <string_view>
 #include <memory>
 #include <optional>
 #include <span>
@@ -43,6 +45,8 @@ struct ControllerOptions {
   // Fault injection: when line `alarm_at_line` is about to execute, raise EMERGENCY_STOP
   // (0: never).
   std::uint32_t alarm_at_line = 0;
+  // Called after every executed line with its number and text (the run's line log).
+  std::function<void(std::uint32_t number, std::string_view text)> on_line_executed;
 };
 
 // The run report (`sim serve` writes it as JSON at the end).
