@@ -18,8 +18,14 @@
 #include <stdexcept>
 #include <string>
 
+#include <string_view>
+
 #include "drivers/protocol/chunk.hpp"
 #include "drivers/protocol/messages.hpp"
+
+namespace hybridctl::config {
+struct Transport;
+}
 
 namespace hybridctl::drivers {
 
@@ -38,6 +44,9 @@ class TransportError : public std::runtime_error {
  private:
   Kind kind_;
 };
+
+// "unreachable", "timeout", "disconnected", "protocol", "unsupported".
+std::string_view to_string(TransportError::Kind kind);
 
 struct TransportOptions {
   std::chrono::milliseconds response_timeout{500};
@@ -77,5 +86,9 @@ class Transport {
 // Opens (and connects) the backend for `uri`. Throws TransportError (Unreachable,
 // Unsupported) and hybridctl::InputError for a malformed URI.
 std::unique_ptr<Transport> open_transport(const std::string& uri, const TransportOptions& options = {});
+// The same for a transport already parsed (config::parse_transport_uri, a machine file's
+// `transports`). Throws InputError for settings the backend cannot use (e.g. a baud rate
+// libmodbus does not know, which it would silently turn into 9600).
+std::unique_ptr<Transport> open_transport(const config::Transport& where, const TransportOptions& options = {});
 
 }  // namespace hybridctl::drivers
