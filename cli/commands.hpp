@@ -20,5 +20,6 @@ void add_inspect_command(CLI::App& app, Runner& runner);
 void add_plan_command(CLI::App& app, Runner& runner);
 void add_gcode_command(CLI::App& app, Runner& runner);
 void add_export_command(CLI::App& app, Runner& runner);
+void add_sim_command(CLI::App& app, Runner& runner);
 
 }  // namespace hybridctl::cli

@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   add_plan_command(app, runner);
   add_gcode_command(app, runner);
   add_export_command(app, runner);
+  add_sim_command(app, runner);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
