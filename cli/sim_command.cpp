@@ -62,6 +62,7 @@ struct ServeRequest {
   int plan = 1;
   std::string report;
   std::string as_built;
+  std::string line_log;
   bool exit_when_done = false;
   bool allow_remote = false;
   bool modbus_debug = false;
@@ -233,11 +234,28 @@ int serve(const ServeRequest& r) {
   options.buffer_bytes = r.buffer_bytes;
   options.heartbeat_timeout_s = r.heartbeat_timeout_s;
   options.alarm_at_line = faults.alarm_at_line;
+  // A reboot lands after the advance() that crossed its line count: one line per advance
+  // makes it exact (at time scale 0 the loop then spins while lines execute).
+  if (!faults.reboot_after_lines.empty()) options.max_lines_per_advance = 1;
   std::string stock = "none";
   if (!r.stock_plan.empty()) stock_from_plan(r, options, stock);
   if (!r.stock_vdb.empty()) {
     options.stock = geometry::read_vdb(r.stock_vdb);
     stock = r.stock_vdb;
+  }
+  // The line log: every executed line's text, in execution order, one per line, so a test
+  // can compare it with the program byte for byte. Written to FILE.tmp, renamed at the end.
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> line_log(nullptr, &std::fclose);
+  if (!r.line_log.empty()) {
+    line_log.reset(std::fopen((r.line_log + ".tmp").c_str(), "w"));
+    if (!line_log) {
+      std::fprintf(stderr, "hybridctl sim serve: error: --line-log %s: cannot write\n", r.line_log.c_str());
+      return kBadInput;
+    }
+    options.on_line_executed = [f = line_log.get()](std::uint32_t, std::string_view text) {
+      std::fwrite(text.data(), 1, text.size(), f);
+      std::fputc('\n', f);
+    };
   }
   sim::Controller controller(machine, options);
 
@@ -255,6 +273,7 @@ int serve(const ServeRequest& r) {
   sim::ServeLoopOptions loop_options;
   loop_options.exit_when_done = r.exit_when_done;
   loop_options.reboot_after_lines = faults.reboot_after_lines;
+  loop_options.spin_while_executing = r.time_scale == 0;
   sim::ServeLoop loop(controller, loop_options);
 
   // SocketCAN first: on a kernel without it the command fails before anything listens.
@@ -276,6 +295,15 @@ int serve(const ServeRequest& r) {
     socketcand = std::make_unique<sim::SocketcandServer>(controller, socketcand_at->host, socketcand_at->port, o);
   }
 
+  // Before "ready": a test may signal as soon as it reads that line.
+  struct sigaction action {};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  action.sa_flags = 0;  // no SA_RESTART: poll() returns at once
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+  std::signal(SIGPIPE, SIG_IGN);
+
   if (modbus_tcp) {
     loop.add(*modbus_tcp);
     print_line("listening modbus-tcp " + modbus_tcp->address() + ":" + std::to_string(modbus_tcp->port()));
@@ -294,17 +322,14 @@ int serve(const ServeRequest& r) {
   }
   print_line("ready");
 
-  struct sigaction action {};
-  action.sa_handler = on_stop_signal;
-  sigemptyset(&action.sa_mask);
-  action.sa_flags = 0;  // no SA_RESTART: poll() returns at once
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
-  std::signal(SIGPIPE, SIG_IGN);
-
   const sim::ServeExit exit = loop.run(g_stop);
 
   const sim::ControllerReport report = controller.report();
+  if (line_log) {
+    std::fflush(line_log.get());
+    line_log.reset();
+    fs::rename(r.line_log + ".tmp", r.line_log);
+  }
   const protocol::Status status = controller.status();
   if (!r.as_built.empty()) {
     const geometry::Solid built = controller.as_built();
@@ -485,6 +510,7 @@ void add_sim_command(CLI::App& app, Runner& runner) {
   stock_plan->excludes(stock_vdb);
   serve_cmd->add_option("--plan", r->plan, "With --stock: which plan (rank) to take the stock from")->capture_default_str();
   serve_cmd->add_option("--report", r->report, "Write the run report (JSON) here at the end");
+  serve_cmd->add_option("--line-log", r->line_log, "Write every executed program line here, in execution order");
   serve_cmd->add_option("--as-built", r->as_built, "Write the stock as built at the end (.vdb or .stl)");
   serve_cmd->add_flag("--exit-when-done", r->exit_when_done, "Exit once the program completed (after 0.5 s more)");
   serve_cmd->add_flag("--allow-remote", r->allow_remote, "Allow binding to addresses other than loopback");

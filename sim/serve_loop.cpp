@@ -42,6 +42,7 @@ ServeExit ServeLoop::run(const std::atomic<bool>& stop) {
   SteadyTime completed_at = SteadyTime::max();
   ServeExit result = ServeExit::Stopped;
 
+  bool executing = false;  // the last advance() executed lines
   while (!stop.load(std::memory_order_relaxed)) {
     fds.clear();
     for (std::size_t i = 0; i < endpoints_.size(); ++i) {
@@ -50,7 +51,7 @@ ServeExit ServeLoop::run(const std::atomic<bool>& stop) {
       counts[i] = fds.size() - before;
     }
     SteadyTime now = SteadyClock::now();
-    SteadyTime wake = now + options_.max_wait;
+    SteadyTime wake = executing && options_.spin_while_executing ? now : now + options_.max_wait;
     for (const WireEndpoint* e : endpoints_) wake = std::min(wake, e->next_deadline());
     const auto wait = std::max(std::chrono::nanoseconds(0), std::chrono::nanoseconds(wake - now));
     timespec ts{static_cast<time_t>(wait.count() / 1'000'000'000), static_cast<long>(wait.count() % 1'000'000'000)};
@@ -58,8 +59,10 @@ ServeExit ServeLoop::run(const std::atomic<bool>& stop) {
     if (rc < 0 && errno != EINTR) throw std::system_error(errno, std::generic_category(), "sim serve: poll");
 
     now = SteadyClock::now();
+    const std::size_t executed_before = controller_.executed_lines().size();
     controller_.advance(std::chrono::duration<double>(now - last).count());
     last = now;
+    executing = controller_.executed_lines().size() != executed_before;
     apply_reboot_schedule();
 
     if (rc > 0) {

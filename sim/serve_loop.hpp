@@ -48,7 +48,13 @@ struct ServeLoopOptions {
   /// so the hosts see the final status).
   bool exit_when_done = false;
   /// Reboot the controller once it executed this many lines (each value once, ascending).
+  /// The reboot comes after the advance() that crossed the count: for an exact line, give
+  /// the controller max_lines_per_advance = 1 (and spin_while_executing at time scale 0).
   std::vector<std::uint32_t> reboot_after_lines;
+  /// Do not sleep while the controller is executing lines (time scale 0: as fast as
+  /// possible, even with a small max_lines_per_advance). The loop still sleeps while the
+  /// controller waits for chunks or commands.
+  bool spin_while_executing = false;
 };
 
 enum class ServeExit { Stopped, Completed };

@@ -80,7 +80,7 @@ bool valid_channel(std::string_view name) {
 SocketcandParse parse_socketcand_element(std::string_view element) {
   SocketcandParse out;
   if (element.size() < 2 || element.front() != '<' || element.back() != '>') {
-    out.error = "expected an element '< ... >'";
+    out.error = "expected an element between angle brackets";
     return out;
   }
   const auto words = split_words(element.substr(1, element.size() - 2));
@@ -99,7 +99,7 @@ SocketcandParse parse_socketcand_element(std::string_view element) {
   };
   if (cmd == "open") {
     if (words.size() != 2 || !valid_channel(words[1])) {
-      out.error = "expected '< open CHANNEL >' with a bus name of 1-15 letters, digits, '_', '.' or '-'";
+      out.error = "expected 'open CHANNEL' with a bus name of 1-15 letters, digits, '_', '.' or '-'";
       return out;
     }
     out.request = SocketcandRequest{SocketcandRequest::Kind::Open, std::string(words[1]), {}};
@@ -111,7 +111,7 @@ SocketcandParse parse_socketcand_element(std::string_view element) {
   if (cmd == "send") {
     std::uint32_t id = 0, len = 0;
     if (words.size() < 3 || !parse_hex(words[1], 8, id) || id > 0x1FFFFFFF) {
-      out.error = "expected '< send ID LEN B0 ... >' with ID hex up to 1FFFFFFF";
+      out.error = "expected 'send ID LEN B0 ...' with ID hex up to 1FFFFFFF";
       return out;
     }
     if (!parse_hex(words[2], 1, len) || len > 8) {
@@ -240,7 +240,7 @@ struct SocketcandServer::Impl {
         break;
       case K::RawMode:
         if (c.mode == Mode::NoBus) {
-          error(c, "rawmode before '< open CHANNEL >'");
+          error(c, "rawmode before 'open CHANNEL'");
           return;
         }
         c.mode = Mode::Raw;
@@ -249,7 +249,7 @@ struct SocketcandServer::Impl {
         break;
       case K::BcmMode:
         if (c.mode == Mode::NoBus) {
-          error(c, "bcmmode before '< open CHANNEL >'");
+          error(c, "bcmmode before 'open CHANNEL'");
           return;
         }
         c.mode = Mode::Bcm;
@@ -260,7 +260,7 @@ struct SocketcandServer::Impl {
         break;
       case K::Send: {
         if (c.mode == Mode::NoBus) {
-          error(c, "send before '< open CHANNEL >'");
+          error(c, "send before 'open CHANNEL'");
           return;
         }
         ++counters.frames_from_hosts;
@@ -299,20 +299,20 @@ struct SocketcandServer::Impl {
         const std::size_t next = in.find('<', i);
         const std::size_t end = next == std::string::npos ? in.size() : next;
         error(c, "unexpected text '" + quote(std::string_view(in).substr(i, end - i)) +
-                     "' outside an element, expected '< command ... >'");
+                     "' outside an element, expected an element between angle brackets");
         i = end;
         continue;
       }
       const std::size_t close = in.find('>', i);
       const std::size_t nested = in.find('<', i + 1);
       if (nested != std::string::npos && (close == std::string::npos || nested < close)) {
-        error(c, "element '" + quote(std::string_view(in).substr(i, nested - i)) + "' has no closing '>'");
+        error(c, "element '" + quote(std::string_view(in).substr(i, nested - i)) + "' is not closed before the next one opens");
         i = nested;
         continue;
       }
       if (close == std::string::npos) {
         if (in.size() - i > kMaxElement) {
-          error(c, "element longer than " + std::to_string(kMaxElement) + " characters without '>'");
+          error(c, "element longer than " + std::to_string(kMaxElement) + " characters without its end");
           i = in.size();
         }
         break;  // wait for the rest

@@ -9,7 +9,8 @@
 //   server: < frame ID SEC.USEC DATAHEX >                  ID %03X (%08X above 0x7FF), data bytes run together
 //   client: < echo >             server: < echo >
 //   client: < bcmmode >          server: < ok >            back to broadcast-manager mode (no frames)
-//   anything else, or a malformed element:   server: < error WHAT >   (nothing is put on the bus)
+//   anything else, or a malformed element:   server: < error WHAT >   (nothing is put on the bus;
+//                                            WHAT never holds an angle bracket)
 //
 // The bus is shared: a frame a client sends reaches the controller node (sim/can_node.hpp)
 // and every other raw-mode client; the node's frames (status snapshots, flow control)

@@ -1,5 +1,6 @@
 #include "wire_client.hpp"
 
+#include <algorithm>
 #include <cerrno>
 
 #include <arpa/inet.h>
@@ -116,6 +117,20 @@ std::string RawSocket::receive(std::chrono::milliseconds wait, const std::string
     if (::poll(&p, 1, static_cast<int>(std::max<long>(0, left.count()))) <= 0) break;
     char buffer[4096];
     const ssize_t n = ::recv(fd_, buffer, sizeof buffer, 0);
+    if (n <= 0) break;
+    out.append(buffer, static_cast<std::size_t>(n));
+  }
+  return out;
+}
+
+std::string RawSocket::receive_bytes(std::size_t count, std::chrono::milliseconds wait) {
+  std::string out;
+  const auto end = std::chrono::steady_clock::now() + wait;
+  while (out.size() < count && std::chrono::steady_clock::now() < end) {
+    pollfd p{fd_, POLLIN, 0};
+    if (::poll(&p, 1, 20) <= 0) continue;
+    char buffer[512];
+    const ssize_t n = ::recv(fd_, buffer, std::min(sizeof buffer, count - out.size()), 0);
     if (n <= 0) break;
     out.append(buffer, static_cast<std::size_t>(n));
   }

@@ -64,6 +64,8 @@ class RawSocket {
   bool send(const std::string& bytes);
   /// Reads what arrives within `wait` (stops early once `until` appears, if given).
   std::string receive(std::chrono::milliseconds wait, const std::string& until = {});
+  /// Reads until `count` bytes arrived or `wait` passed.
+  std::string receive_bytes(std::size_t count, std::chrono::milliseconds wait);
   /// True when the peer closed the connection (EOF or reset) within `wait`.
   bool closed_by_peer(std::chrono::milliseconds wait);
 
