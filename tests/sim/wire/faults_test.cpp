@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -267,6 +268,45 @@ TEST(SimServe, WritesTheAsBuiltStockOfAVdbStock) {
   const json report = read_json(dir / "run.json");
   EXPECT_NEAR(report["volumes_mm3"]["as_built"].get<double>(), block.volume(), 1e-6);
   EXPECT_EQ(report["stock"], (dir / "stock.vdb").string());
+  fs::remove_all(dir);
+}
+
+TEST(SimServe, TakesTheStockFromAPlan) {
+  const fs::path dir = temp_dir("plan-stock");
+  const PeerResult plan = run_peer({HYBRIDCTL_EXE, "plan", std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/bracket.stl",
+                                    "--machine", example_machine(), "--voxel", "1", "-o", (dir / "plan").string()});
+  ASSERT_EQ(plan.exit_code, 0) << plan.output;
+  // The ranks of a plan that starts from a raw stock and of one that starts by depositing.
+  const json plans = read_json(dir / "plan" / "plan.json");
+  std::map<std::string, std::string> kind;
+  for (const json& p : plans["primitives"]) kind[p["name"]] = p["kind"];
+  int from_stock = 0, from_nothing = 0;
+  for (const json& p : plans["plans"]) {
+    const bool raw = kind[p["actions"][0]["primitive"]] == "raw-stock";
+    int& rank = raw ? from_stock : from_nothing;
+    if (rank == 0) rank = p["rank"];
+  }
+  ASSERT_GT(from_stock, 0) << "the bracket's plans should include one from a raw stock";
+  const geometry::Solid design = geometry::read_vdb(dir / "plan" / "design.vdb");
+
+  auto serve_plan = [&](int rank, json& report, geometry::Solid& built) {
+    SimProcess sim(serve_args({"--stock", (dir / "plan" / "plan.json").string(), "--plan", std::to_string(rank),
+                               "--as-built", (dir / "built.vdb").string(), "--report", (dir / "run.json").string()}));
+    ASSERT_EQ(sim.stop(), 0) << sim.errors();
+    report = read_json(dir / "run.json");
+    built = geometry::read_vdb(dir / "built.vdb");
+  };
+  json report;
+  geometry::Solid built;
+  serve_plan(from_stock, report, built);
+  EXPECT_EQ(report["stock"].get<std::string>().rfind("raw stock ", 0), 0u) << report["stock"];
+  EXPECT_GT(built.volume(), design.volume()) << "the raw stock holds the part";
+  EXPECT_NEAR(report["volumes_mm3"]["as_built"].get<double>(), built.volume(), 1e-6);
+  if (from_nothing > 0) {
+    serve_plan(from_nothing, report, built);
+    EXPECT_EQ(report["stock"].get<std::string>().rfind("empty", 0), 0u) << report["stock"];
+    EXPECT_EQ(built.volume(), 0.0) << "a plan that starts by depositing starts from nothing";
+  }
   fs::remove_all(dir);
 }
 
