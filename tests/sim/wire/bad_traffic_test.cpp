@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <random>
 
 #include "drivers/protocol/modbus_map.hpp"
 #include "sim_process.hpp"
@@ -28,7 +29,9 @@ class BadTraffic : public ::testing::Test {
   }
   void TearDown() override {
     good_.reset();
-    if (sim_) EXPECT_EQ(sim_->stop(), 0) << sim_->errors();
+    if (sim_) {
+      EXPECT_EQ(sim_->stop(), 0) << sim_->errors();
+    }
   }
   // The second client is still served, and the status is what it was.
   void expect_good_client_served(const char* after) {
@@ -198,6 +201,33 @@ TEST_F(BadTraffic, BadCrcIsRefusedThenTheGoodChunkIsAccepted) {
   ASSERT_TRUE(good.has_value());
   EXPECT_EQ(good->chunk_result, ResultCode::Accepted);
   EXPECT_EQ(good->last_accepted_chunk, 1u);
+}
+
+// Random bytes, and well-framed requests with random PDUs, from many short connections:
+// the server answers or drops each, and never stops serving the good client.
+TEST_F(BadTraffic, RandomTrafficNeverTakesTheServerDown) {
+  std::mt19937 random(20261125);
+  auto byte = [&] { return static_cast<char>(random() & 0xFF); };
+  for (int i = 0; i < 300; ++i) {
+    RawSocket raw(port_);
+    ASSERT_GE(raw.fd(), 0) << "connection " << i;
+    std::string frame;
+    if (i % 2 == 0) {  // raw garbage
+      frame.resize(1 + random() % 300);
+      for (char& c : frame) c = byte();
+    } else {  // a good MBAP header around a random PDU (function codes around the served ones)
+      std::string pdu(1 + random() % 250, 0);
+      for (char& c : pdu) c = byte();
+      pdu[0] = static_cast<char>(std::vector<int>{3, 4, 6, 16, 23, 1, 0x2B, 0x80 | 3}[random() % 8]);
+      frame = bytes({int(random() & 0xFF), int(random() & 0xFF), 0, 0, int((pdu.size() + 1) >> 8),
+                     int((pdu.size() + 1) & 0xFF), 1}) +
+              pdu;
+    }
+    raw.send(frame);
+    raw.receive(5ms);
+    if (i % 25 == 0) expect_good_client_served("random traffic");
+  }
+  expect_good_client_served("random traffic");
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <map>
+#include <random>
 #include <regex>
 #include <sstream>
 
@@ -214,6 +215,32 @@ TEST(CanBusTiming, FrameTimesFollowTheBitCount) {
   EXPECT_EQ(bus.reserve(t0, 8).count(), 1135);
   EXPECT_EQ(bus.reserve(t0, 8).count(), 1270) << "a frame waits for the one before it";
   EXPECT_EQ(bus.reserve(sim::CanMicros{5000}, 0).count(), 5055) << "an idle bus starts at once";
+}
+
+TEST(Socketcand, RandomTextNeverTakesTheServerDown) {
+  SimProcess sim({"--machine", example_machine(), "--socketcand", "127.0.0.1:0", "--time-scale", "0"});
+  TextClient good(sim.socketcand_port());
+  ASSERT_TRUE(good.open_raw());
+  std::mt19937 random(7);
+  const std::string alphabet = "<> sendopenrawmodeecho0123456789abcdefABCDEF\n\t\x01\xff";
+  for (int i = 0; i < 200; ++i) {
+    TextClient raw(sim.socketcand_port());
+    raw.socket.receive(200ms, "< hi >");
+    std::string text = i % 3 == 0 ? "< open can0 >< rawmode >" : "";
+    const std::size_t n = 1 + random() % 400;
+    for (std::size_t k = 0; k < n; ++k) text += alphabet[random() % alphabet.size()];
+    if (i % 5 == 0) {  // frames that are well formed but random: whatever they say, on the bus they go
+      text += "< send " + std::to_string(0x100 + random() % 0x700) + " 8";
+      for (int b = 0; b < 8; ++b) text += " " + std::to_string(random() % 100);
+      text += " >";
+    }
+    raw.socket.send(text);
+    raw.socket.receive(5ms);
+  }
+  good.socket.receive(200ms);  // drain
+  EXPECT_NE(good.socket.receive(2s, "< frame 181 ").find("< frame 181 "), std::string::npos)
+      << "the good client still gets status frames";
+  EXPECT_EQ(sim.stop(), 0) << sim.errors();
 }
 
 }  // namespace
