@@ -109,6 +109,7 @@ TEST(SimServe, ExitsWhenTheProgramIsDoneAndReportsTheRun) {
   const auto done = host.wait([](const protocol::Status& s) { return s.state == ControllerState::Completed; });
   ASSERT_TRUE(done.has_value()) << sim.errors();
   EXPECT_EQ(done->last_executed_line, host.lines());
+  EXPECT_NE(done->heartbeat_echo, 0) << "the FC6 heartbeat writes reach the controller";
 
   ASSERT_EQ(sim.wait(10s), 0) << "exit when done: " << sim.errors();
   EXPECT_NE(sim.output().find("stopped (program completed)"), std::string::npos) << sim.output();
