@@ -167,7 +167,9 @@ void SocketCanEndpoint::tick(SteadyTime now) {
 
 SteadyTime SocketCanEndpoint::next_deadline() const {
   CanMicros t = impl_->node.next_deadline();
-  if (!impl_->outgoing.empty()) t = std::min(t, impl_->outgoing.front().due);
+  // A frame already due waits for POLLOUT (the interface's queue was full): look again in
+  // a millisecond at the latest rather than spinning.
+  if (!impl_->outgoing.empty()) t = std::min(t, std::max(impl_->outgoing.front().due, can_now() + CanMicros{1000}));
   return SteadyTime(std::chrono::duration_cast<SteadyClock::duration>(t));
 }
 
