@@ -1,6 +1,7 @@
 #include "drivers/can_link.hpp"
 
 #include <algorithm>
+#include <random>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -24,6 +25,14 @@ SteadyTime to_steady(can::Micros t) { return SteadyTime(std::chrono::duration_ca
 
 // Frames at most taken in one drain, so a flooded bus cannot hold a call forever.
 constexpr int kMaxDrainFrames = 4096;
+
+// After a transfer whose first flow control never came (the segmenter waited the
+// protocol's 1000 ms), this much more passes before the chunk is resent, so that the
+// controller's reassembler (which drops a transfer 1000 ms after its last frame) has
+// dropped it and does not take the resent first frame for a repeat of the old one.
+constexpr std::chrono::milliseconds kResendMargin{150};
+// Every resend after a transfer timeout waits a random 0..kResendJitterMs ms more.
+constexpr unsigned kResendJitterMs = 100;
 
 }  // namespace
 
@@ -61,7 +70,7 @@ void CanTransport::ensure_open() {
       io_->close();
       if (e.kind() != Kind::Unreachable) throw;
       if (!backoff.wait_after_failure())
-        throw TransportError(Kind::Unreachable, describe() + ": " + e.what() + " (" + std::to_string(backoff.failures()) +
+        throw TransportError(Kind::Unreachable, std::string(e.what()) + " (" + std::to_string(backoff.failures()) +
                                                     " attempt" + (backoff.failures() == 1 ? "" : "s") + ")");
     }
   }
@@ -70,6 +79,11 @@ void CanTransport::ensure_open() {
   in_snapshot_ = false;
   if (ever_open_) ++counters_.reconnects;
   ever_open_ = true;
+  // Wait for the bus to flow (the controller's periodic status) before talking: a
+  // socketcand may pass frames to a new raw-mode client only a moment after its `< ok >`,
+  // and a flow control sent in that moment would be lost (a transfer stalled for the
+  // whole flow control timeout). A silent bus costs one response timeout here.
+  if (auto frame = io_->receive(SteadyClock::now() + options_.response_timeout)) dispatch(*frame);
 }
 
 void CanTransport::dispatch(const can::CanFrame& frame) {
@@ -185,6 +199,8 @@ protocol::Status CanTransport::send_chunk(const protocol::Chunk& chunk) {
   const std::string what = "chunk " + std::to_string(chunk.seq);
   return run(what, [&]() -> std::variant<protocol::Status, Issue> {
     drain();
+    // The flow control timeout stays the protocol's 1000 ms whatever the response timeout:
+    // it matches the controller's wait for a silent sender (see kResendMargin).
     can::CanSegmenter segmenter(node_);
     if (auto error = segmenter.begin(message.value(), can::chunk_transfer_id(chunk.seq), now_micros()))
       throw InputError(describe() + ": " + what + ": " + error->message);
@@ -211,6 +227,17 @@ protocol::Status CanTransport::send_chunk(const protocol::Chunk& chunk) {
       const auto& error = segmenter.error();
       const bool timeout = error && (error->kind == can::TransferErrorKind::Timeout ||
                                      error->kind == can::TransferErrorKind::TooManyWaits);
+      if (timeout) {
+        // The controller may hold our first frame, its flow control lost: until it gives
+        // the transfer up (1000 ms after that frame) it takes the same first frame again
+        // for a repeat and stays silent, so let that time pass. And a random pause keeps
+        // the resends from falling into step with periodic trouble on the bus.
+        auto pause = std::chrono::milliseconds(std::random_device{}() % kResendJitterMs);
+        if (segmenter.frames_sent() == 1) pause += kResendMargin;
+        const auto until = SteadyClock::now() + pause;
+        while (SteadyClock::now() < until)
+          if (auto frame = io_->receive(until)) dispatch(*frame);
+      }
       return Issue{timeout ? Kind::Timeout : Kind::Protocol,
                    "transfer failed: " + (error ? error->message : std::string("(no reason given)"))};
     }
