@@ -9,7 +9,15 @@
 namespace hybridctl::cli {
 
 // Exit codes, documented in `hybridctl --help` and the README.
-enum ExitCode : int { kSuccess = 0, kInternalError = 1, kUsage = 2, kBadInput = 3, kNotManufacturable = 4 };
+enum ExitCode : int {
+  kSuccess = 0,
+  kInternalError = 1,
+  kUsage = 2,
+  kBadInput = 3,
+  kNotManufacturable = 4,
+  kMachineStopped = 5,  // run: the machine stopped (alarm, abort, operator) before the program's end
+  kUnreachable = 6,     // run, status: the controller could not be reached
+};
 
 using Runner = std::function<int()>;
 
@@ -21,5 +29,8 @@ void add_plan_command(CLI::App& app, Runner& runner);
 void add_gcode_command(CLI::App& app, Runner& runner);
 void add_export_command(CLI::App& app, Runner& runner);
 void add_sim_command(CLI::App& app, Runner& runner);
+void add_status_command(CLI::App& app, Runner& runner);
+void add_run_command(CLI::App& app, Runner& runner);
+void add_dry_run_command(CLI::App& app, Runner& runner);
 
 }  // namespace hybridctl::cli

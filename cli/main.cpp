@@ -5,6 +5,7 @@
 
 #include "cli/commands.hpp"
 #include "common/error.hpp"
+#include "drivers/transport.hpp"
 
 int main(int argc, char** argv) {
   using namespace hybridctl::cli;
@@ -24,6 +25,9 @@ int main(int argc, char** argv) {
   add_gcode_command(app, runner);
   add_export_command(app, runner);
   add_sim_command(app, runner);
+  add_status_command(app, runner);
+  add_run_command(app, runner);
+  add_dry_run_command(app, runner);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -36,6 +40,10 @@ int main(int argc, char** argv) {
     std::fflush(stdout);  // what was printed so far comes before the error
     std::fprintf(stderr, "hybridctl: error: %s\n", e.what());
     return kBadInput;
+  } catch (const hybridctl::drivers::TransportError& e) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "hybridctl: cannot reach the controller: %s\n", e.what());
+    return kUnreachable;
   } catch (const std::exception& e) {
     std::fflush(stdout);
     std::fprintf(stderr, "hybridctl: internal error: %s\n", e.what());

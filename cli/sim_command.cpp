@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <csignal>
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -234,9 +235,9 @@ int serve(const ServeRequest& r) {
   options.buffer_bytes = r.buffer_bytes;
   options.heartbeat_timeout_s = r.heartbeat_timeout_s;
   options.alarm_at_line = faults.alarm_at_line;
-  // A reboot lands after the advance() that crossed its line count: one line per advance
-  // makes it exact (at time scale 0 the loop then spins while lines execute).
-  if (!faults.reboot_after_lines.empty()) options.max_lines_per_advance = 1;
+  // A reboot lands right after its line: advance() stops there.
+  options.break_after_lines.assign(faults.reboot_after_lines.begin(), faults.reboot_after_lines.end());
+  std::sort(options.break_after_lines.begin(), options.break_after_lines.end());
   std::string stock = "none";
   if (!r.stock_plan.empty()) stock_from_plan(r, options, stock);
   if (!r.stock_vdb.empty()) {

@@ -70,6 +70,16 @@ struct Controller::Impl {
           return ResultCode::WrongState;
         if (c.identity == 0 || c.line_count == 0) return ResultCode::BadArgument;
         acceptor.set_program(c.identity, c.line_count);
+        // A new program starts from the machine's power-on modal state (an earlier M2
+        // ended the last one); the material and the position stay where they are.
+        {
+          ExecutorOptions eo;
+          if (options.stock) eo.stock = executor->stock();
+          eo.protected_region = options.protected_region;
+          gcode::InterpreterOptions io;
+          io.start = executor->state().position;
+          executor = std::make_unique<ProgramExecutor>(machine, "program", std::move(eo), io);
+        }
         chunk.reset();
         chunk_lines.clear();
         next_in_chunk = 0;
@@ -207,6 +217,7 @@ struct Controller::Impl {
     }
     if (state == ControllerState::Running && last_executed_line >= acceptor.line_count())
       state = ControllerState::Completed;
+    if (std::binary_search(options.break_after_lines.begin(), options.break_after_lines.end(), number)) return false;
     return state == ControllerState::Running;
   }
 

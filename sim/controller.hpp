@@ -45,6 +45,9 @@ struct ControllerOptions {
   // Fault injection: when line `alarm_at_line` is about to execute, raise EMERGENCY_STOP
   // (0: never).
   std::uint32_t alarm_at_line = 0;
+  // advance() returns right after executing any of these lines (sorted ascending), so a
+  // fault injector can reboot the controller exactly there.
+  std::vector<std::uint32_t> break_after_lines;
   // Called after every executed line with its number and text (the run's line log).
   std::function<void(std::uint32_t number, std::string_view text)> on_line_executed;
 };

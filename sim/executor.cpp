@@ -57,8 +57,8 @@ struct ProgramExecutor::Impl {
   SimulationReport finished;  // totals of simulations already left
   const config::Setup* current = nullptr;
 
-  Impl(const config::Machine& m, std::string name, ExecutorOptions o)
-      : machine(m), file_name(name), options(std::move(o)), interp(m, std::move(name)) {
+  Impl(const config::Machine& m, std::string name, ExecutorOptions o, gcode::InterpreterOptions io)
+      : machine(m), file_name(name), options(std::move(o)), interp(m, std::move(name), io) {
     for (const auto& t : m.tools) cutters.emplace(t.number, cutter_of(t));
     for (std::size_t i = 0; i < m.heads.size(); ++i)
       beads.emplace(m.heads[i].tool_number > 0 ? m.heads[i].tool_number : int(100 + i), bead_of(m.heads[i]));
@@ -94,8 +94,9 @@ struct ProgramExecutor::Impl {
   bool known(int tool) const { return tool == 0 || cutters.count(tool) || beads.count(tool); }
 };
 
-ProgramExecutor::ProgramExecutor(const config::Machine& machine, std::string file_name, ExecutorOptions options)
-    : impl_(std::make_unique<Impl>(machine, std::move(file_name), std::move(options))) {}
+ProgramExecutor::ProgramExecutor(const config::Machine& machine, std::string file_name, ExecutorOptions options,
+                                 gcode::InterpreterOptions interpreter)
+    : impl_(std::make_unique<Impl>(machine, std::move(file_name), std::move(options), interpreter)) {}
 ProgramExecutor::~ProgramExecutor() = default;
 ProgramExecutor::ProgramExecutor(ProgramExecutor&&) noexcept = default;
 ProgramExecutor& ProgramExecutor::operator=(ProgramExecutor&&) noexcept = default;

@@ -54,7 +54,8 @@ struct LineOutcome {
 
 class ProgramExecutor {
  public:
-  ProgramExecutor(const config::Machine& machine, std::string file_name, ExecutorOptions options = {});
+  ProgramExecutor(const config::Machine& machine, std::string file_name, ExecutorOptions options = {},
+                  gcode::InterpreterOptions interpreter = {});
   ~ProgramExecutor();
   ProgramExecutor(ProgramExecutor&&) noexcept;
   ProgramExecutor& operator=(ProgramExecutor&&) noexcept;

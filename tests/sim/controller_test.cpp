@@ -285,6 +285,19 @@ TEST(Controller, AChunkOfAnotherProgramWhileRunningHoldsTheMachine) {
   EXPECT_EQ(c.status().alarm, AlarmCode::ProgramIdentityMismatch);
 }
 
+TEST(Controller, ASecondProgramRunsAfterOneThatEndedWithM2) {
+  Controller c(machine());
+  for (int round = 0; round < 2; ++round) {
+    Host host(c, program(10 + round));
+    host.seq = std::uint16_t(10 * (round + 1));
+    ASSERT_EQ(host.command(CommandCode::SetProgram), ResultCode::Accepted) << round;
+    host.send_all();
+    ASSERT_EQ(host.command(CommandCode::Start), ResultCode::Accepted);
+    c.advance(0.01);
+    EXPECT_EQ(c.status().state, ControllerState::Completed) << round << " " << protocol::to_string(c.status().alarm);
+  }
+}
+
 TEST(Controller, ARebootWithoutAStartedProgramIsJustIdle) {
   Controller c(machine());
   c.reboot();

@@ -1,0 +1,176 @@
+// hybridctl dry-run: plan a part, export the best plan, run it through a simulated
+// controller (a separate `hybridctl sim serve` process on loopback, over Modbus TCP or
+// socketcand), and compare what it built with what was planned.
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <thread>
+
+#include "cli/commands.hpp"
+#include "cli/run_job.hpp"
+#include "common/error.hpp"
+#include "config/machine_loader.hpp"
+#include "geometry/mesh.hpp"
+#include "geometry/morphology.hpp"
+#include "geometry/vdb_file.hpp"
+#include "planner/plan_file.hpp"
+#include "planner/plan_report.hpp"
+
+namespace hybridctl::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct DryRunArgs {
+  std::string part, machine, output = "out/dry-run", transport = "modbus";
+  double voxel = 0;
+  double time_scale = 0;
+};
+
+// `hybridctl sim serve` as a child process; killed when this goes out of scope.
+class Simulator {
+ public:
+  Simulator(const std::vector<std::string>& args, const fs::path& log) {
+    int out[2];
+    if (::pipe(out) != 0) throw std::runtime_error("pipe failed");
+    pid_ = ::fork();
+    if (pid_ < 0) throw std::runtime_error("fork failed");
+    if (pid_ == 0) {
+      ::dup2(out[1], STDOUT_FILENO);
+      const int err = ::open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (err >= 0) ::dup2(err, STDERR_FILENO);
+      ::close(out[0]);
+      std::vector<char*> argv;
+      for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+      argv.push_back(nullptr);
+      ::execv("/proc/self/exe", argv.data());
+      ::_exit(127);
+    }
+    ::close(out[1]);
+    stdout_ = ::fdopen(out[0], "r");
+  }
+  ~Simulator() {
+    if (pid_ > 0 && !exited_) {
+      ::kill(pid_, SIGTERM);
+      wait();
+    }
+    if (stdout_) std::fclose(stdout_);
+  }
+  // The port from the first line starting with `listening KIND`.
+  int port(const std::string& kind) {
+    char line[512];
+    while (std::fgets(line, sizeof line, stdout_)) {
+      const std::string l(line);
+      const std::string key = "listening " + kind + " ";
+      if (l.rfind(key, 0) == 0) return std::stoi(l.substr(l.rfind(':') + 1));
+    }
+    throw std::runtime_error("the simulator did not start (see its log)");
+  }
+  int wait() {
+    int status = 0;
+    ::waitpid(pid_, &status, 0);
+    exited_ = true;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  }
+
+ private:
+  pid_t pid_ = -1;
+  bool exited_ = false;
+  FILE* stdout_ = nullptr;
+};
+
+int run_dry_run(const DryRunArgs& a) {
+  if (a.transport != "modbus" && a.transport != "can")
+    throw InputError("--transport " + a.transport + ": expected modbus or can");
+  const config::Machine machine = config::load_machine(a.machine);
+  const fs::path out = a.output;
+  fs::create_directories(out);
+
+  // 1. Plan.
+  planner::PlanningOptions options;
+  options.voxel_size = a.voxel;
+  const planner::PlanningResult planned = planner::plan_part(geometry::read_stl(a.part), a.part, machine, options);
+  const planner::ReportSources sources{a.part, a.machine, machine.name};
+  std::fputs(planner::plan_summary(planned, sources).c_str(), stdout);
+  if (!planned.verdict.manufacturable || planned.plans.empty()) return kNotManufacturable;
+  const fs::path plan_dir = out / "plan";
+  planner::write_plan_directory(planned, sources, plan_dir);
+
+  // 2. A simulated controller on loopback, starting from the plan's raw stock.
+  const fs::path report = out / "sim-report.json", as_built = out / "as-built.vdb", lines_log = out / "executed-lines.ngc";
+  std::vector<std::string> args = {"hybridctl", "sim", "serve", "--machine", a.machine, "--stock", (plan_dir / "plan.json").string(),
+                                   "--time-scale", std::to_string(a.time_scale), "--exit-when-done", "--report",
+                                   report.string(), "--as-built", as_built.string(), "--line-log", lines_log.string()};
+  if (a.transport == "modbus") {
+    args.insert(args.end(), {"--modbus", "tcp://127.0.0.1:0"});
+  } else {
+    args.insert(args.end(), {"--socketcand", "127.0.0.1:0"});
+  }
+  Simulator sim(args, out / "sim.log");
+  const int port = sim.port(a.transport == "modbus" ? "modbus-tcp" : "socketcand");
+  const std::string uri = a.transport == "modbus" ? "modbus-tcp://127.0.0.1:" + std::to_string(port)
+                                                  : "socketcand://127.0.0.1:" + std::to_string(port) + "/can0";
+  std::printf("simulator   %s (log %s)\n", uri.c_str(), (out / "sim.log").c_str());
+
+  // 3. Run the best plan through it, unattended.
+  fs::remove_all(out / "job");
+  RunRequest run;
+  run.input = (plan_dir / "plan.json").string();
+  run.machine = a.machine;
+  run.transport = uri;
+  run.job = (out / "job").string();
+  run.yes = true;
+  const int code = run_job(run);
+  const int sim_code = sim.wait();
+  if (code != kSuccess) return code;
+  if (sim_code != 0) throw std::runtime_error("the simulator exited with " + std::to_string(sim_code));
+
+  // 4. As built versus as planned.
+  const planner::PlanFile file = planner::read_plan_file(plan_dir);
+  const geometry::Solid planned_shape = planner::plan_states(file, file.plans[0]).back();
+  const geometry::Solid built = geometry::read_vdb(as_built);
+  geometry::Solid built_here(file.lattice, file.domain);
+  built.for_each_voxel([&](geometry::Index3 v) {
+    if (file.domain.contains(v)) built_here.set(v);
+  });
+  const geometry::Solid extra = subtract(built_here, planned_shape), missing = subtract(planned_shape, built_here);
+  const geometry::Solid over = subtract(built_here, file.design), under = subtract(file.design, built_here);
+  const double h = file.lattice.voxel_size;
+  const double worst_over = std::max(0.0, geometry::farthest_distance(over, file.design) - (over.empty() ? 0 : h / 2));
+  const double worst_under = std::max(
+      0.0, geometry::farthest_distance(under, complement(file.design, file.domain)) - (under.empty() ? 0 : h / 2));
+  std::printf("as built    %.1f mm³ (planned %.1f mm³): %.1f mm³ beyond the plan, %.1f mm³ of it missing\n",
+              built_here.volume(), planned_shape.volume(), extra.volume(), missing.volume());
+  std::printf("vs design   %.1f mm³ over (worst %.2f mm), %.1f mm³ under (worst %.2f mm); tolerance %.2f mm\n", over.volume(),
+              worst_over, under.volume(), worst_under, file.tolerance);
+  std::printf("wrote       %s: plan/, job/, as-built.vdb, sim-report.json, executed-lines.ngc\n", out.c_str());
+  return kSuccess;
+}
+
+}  // namespace
+
+void add_dry_run_command(CLI::App& app, Runner& runner) {
+  auto a = std::make_shared<DryRunArgs>();
+  auto* cmd = app.add_subcommand("dry-run",
+                                 "Plan a part, export the best plan, run it through a simulated controller (a separate "
+                                 "`hybridctl sim serve` process on 127.0.0.1) and compare as built with as planned");
+  cmd->add_option("PART", a->part, "Part mesh (closed STL, mm)")->required();
+  cmd->add_option("-m,--machine", a->machine, "Machine description (YAML)")->required();
+  cmd->add_option("--transport", a->transport, "modbus (Modbus TCP) or can (socketcand)")->capture_default_str();
+  cmd->add_option("-o,--output", a->output, "Directory for the plan, the job and the simulator's output")->capture_default_str();
+  cmd->add_option("--voxel", a->voxel, "Voxel size in mm (default: the machine file's)")->check(CLI::PositiveNumber);
+  cmd->add_option("--time-scale", a->time_scale, "Simulated seconds per real second (0: as fast as possible)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd->callback([&runner, a] { runner = [a] { return run_dry_run(*a); }; });
+}
+
+}  // namespace hybridctl::cli
