@@ -122,7 +122,9 @@ class Session {
       if (status_.identity != identity_ || !protocol::accepts_chunks(status_.state)) return;
       const std::uint32_t line = status_.next_line;
       if (line == 0 || line > lines_.size()) return;
-      const std::size_t room = std::min<std::size_t>(max, status_.free_buffer_bytes);
+      // The transport's limit, the controller's advertised one, and its free space.
+      std::size_t room = std::min<std::size_t>(max, status_.free_buffer_bytes);
+      if (status_.max_chunk_payload > 0) room = std::min<std::size_t>(room, status_.max_chunk_payload);
       if (room < 2) return;
       auto chunk = protocol::make_chunk(lines_, line, status_.last_accepted_chunk + 1, identity_, room);
       if (!chunk.ok()) {
@@ -144,7 +146,19 @@ class Session {
         return;
       } else {
         ++result_.counters.refused;
-        return;  // the status has the truth; the next round starts from it
+        // The status has the truth and the next round starts from it; a controller that
+        // keeps refusing the same chunk for the same reason will not change its mind.
+        if (c.seq == refused_seq_ && r == refused_result_) {
+          if (++refusals_ >= 20)
+            throw InputError("the controller keeps refusing chunk " + std::to_string(c.seq) + " (line " +
+                             std::to_string(c.first_line) + "): " + std::string(protocol::to_string(r)) + ": " +
+                             std::string(protocol::result_info(r).meaning));
+        } else {
+          refused_seq_ = c.seq;
+          refused_result_ = r;
+          refusals_ = 1;
+        }
+        return;
       }
     }
   }
@@ -241,6 +255,9 @@ class Session {
   std::uint16_t boot_ = 0, seq_ = 0, heartbeat_ = 0;
   Clock::time_point last_heartbeat_;
   bool started_ = false, held_by_us_ = false, host_hold_ = false;
+  std::uint32_t refused_seq_ = 0;
+  ResultCode refused_result_ = ResultCode::None;
+  int refusals_ = 0;
   StreamResult result_;
 };
 
