@@ -186,8 +186,10 @@ struct ModbusTransport::Impl {
   }
 
   // Runs `once` (one request; nullopt on success) until it succeeds, recovering from
-  // failures as the header describes. `what` names the request for messages.
-  void run(const std::string& what, const std::function<std::optional<Issue>()>& once) {
+  // failures as the header describes. `what` names the request for messages (made only
+  // when one is needed: this is the hot path of streaming).
+  using What = std::function<std::string()>;
+  void run(const What& what, const std::function<std::optional<Issue>()>& once) {
     int resends = 0;
     while (true) {
       connect();
@@ -200,7 +202,7 @@ struct ModbusTransport::Impl {
         default: break;
       }
       if (issue->recovery == Recovery::GiveUp || resends >= options.request_retries)
-        throw TransportError(issue->kind, describe() + ": " + what + ": " + issue->message +
+        throw TransportError(issue->kind, describe() + ": " + what() + ": " + issue->message +
                                               (resends ? " (after " + std::to_string(resends) + " resend" +
                                                              (resends == 1 ? "" : "s") + ")"
                                                        : std::string()));
@@ -233,11 +235,13 @@ struct ModbusTransport::Impl {
   }
 
   // FC23: writes `values` at `address`, reads the status mirror, in one request.
-  protocol::Status write_and_read_status(const std::string& what, int address, const std::vector<std::uint16_t>& values) {
+  protocol::Status write_and_read_status(const What& what, int address, const std::vector<std::uint16_t>& values) {
     protocol::Status status;
     std::vector<std::uint16_t> regs(protocol::kStatusRegisters);
-    run(what + " (FC23 write " + register_range(address, values.size()) + ", read " +
-            register_range(mb::kStatusMirrorAddress, mb::kStatusCount) + ")",
+    run([&] {
+          return what() + " (FC23 write " + register_range(address, values.size()) + ", read " +
+                 register_range(mb::kStatusMirrorAddress, mb::kStatusCount) + ")";
+        },
         [&]() -> std::optional<Issue> {
           const int rc = modbus_write_and_read_registers(ctx, address, static_cast<int>(values.size()), values.data(),
                                                          mb::kStatusMirrorAddress, mb::kStatusCount, regs.data());
@@ -259,7 +263,7 @@ std::size_t ModbusTransport::max_chunk_payload() const { return mb::kMaxChunkPay
 protocol::Status ModbusTransport::read_status() {
   protocol::Status status;
   std::vector<std::uint16_t> regs(protocol::kStatusRegisters);
-  impl_->run("read the status (FC4 input registers " + register_range(mb::kStatusAddress, mb::kStatusCount) + ")",
+  impl_->run([] { return "read the status (FC4 input registers " + register_range(mb::kStatusAddress, mb::kStatusCount) + ")"; },
              [&]() -> std::optional<Issue> {
                const int rc = modbus_read_input_registers(impl_->ctx, mb::kStatusAddress, mb::kStatusCount, regs.data());
                return Impl::take_status(rc, regs, status);
@@ -270,7 +274,7 @@ protocol::Status ModbusTransport::read_status() {
 protocol::Status ModbusTransport::send_command(const protocol::Command& command) {
   const auto block = protocol::encode_command(command);
   return impl_->write_and_read_status(
-      "command " + std::string(protocol::to_string(command.code)) + " seq " + std::to_string(command.seq),
+      [&] { return "command " + std::string(protocol::to_string(command.code)) + " seq " + std::to_string(command.seq); },
       mb::kCommandAddress, std::vector<std::uint16_t>(block.begin(), block.end()));
 }
 
@@ -279,11 +283,12 @@ protocol::Status ModbusTransport::send_chunk(const protocol::Chunk& chunk) {
   if (!mailbox.ok())
     throw InputError(describe() + ": chunk " + std::to_string(chunk.seq) + " (lines from " +
                      std::to_string(chunk.first_line) + ") cannot be sent: " + mailbox.error().message);
-  return impl_->write_and_read_status("chunk " + std::to_string(chunk.seq), mb::kMailboxAddress, mailbox.value());
+  return impl_->write_and_read_status([&] { return "chunk " + std::to_string(chunk.seq); }, mb::kMailboxAddress,
+                                      mailbox.value());
 }
 
 void ModbusTransport::send_heartbeat(std::uint16_t counter) {
-  impl_->run("heartbeat (FC6 write holding register " + std::to_string(mb::kHeartbeatAddress) + ")",
+  impl_->run([] { return "heartbeat (FC6 write holding register " + std::to_string(mb::kHeartbeatAddress) + ")"; },
              [&]() -> std::optional<Issue> {
                if (modbus_write_register(impl_->ctx, mb::kHeartbeatAddress, counter) < 0) return classify(errno);
                return std::nullopt;

@@ -85,8 +85,8 @@ std::vector<std::string> program_of(int moves) {
   char line[64];
   for (int i = 0; i < moves; ++i) {
     // "G1 X12.345 Y23.456 Z20 F1200": about 28 bytes, inside the example machine's travel.
-    std::snprintf(line, sizeof line, "G1 X%.3f Y%.3f Z20 F1200\n", 10 + (i * 7919 % 40000) / 1000.0,
-                  10 + (i * 104729 % 20000) / 1000.0);
+    std::snprintf(line, sizeof line, "G1 X%.3f Y%.3f Z20 F1200\n", 10 + (i * 7919LL % 40000) / 1000.0,
+                  10 + (i * 104729LL % 20000) / 1000.0);
     p += line;
   }
   p += "M5\nM2\n";

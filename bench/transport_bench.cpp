@@ -1,0 +1,269 @@
+// The host's Modbus TCP transport (drivers/modbus_transport.hpp) on loopback against
+// `hybridctl sim serve` at time scale 0: chunks of up to 222 payload bytes (~8 lines of
+// ~28 bytes) sent with ModbusTransport::send_chunk (one FC23 request: mailbox written,
+// status mirror read), against a bare libmodbus FC23 loop sending the same chunks to the
+// same simulator in the same run. The simulator and this process are pinned to CPU 0 (on
+// these 2-vCPU machines unpinned loopback round trips swing 4x; ../shared/PEERS.md), so the
+// ratio of the two figures is the number to compare across machines: what the transport
+// (status decoding, error handling, counters) costs over libmodbus itself.
+//
+//   scripts/build -DHYBRIDCTL_BUILD_BENCH=ON && build/bench/transport_bench
+
+#include <benchmark/benchmark.h>
+
+#include <modbus/modbus.h>
+#include <poll.h>
+#include <sched.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "drivers/protocol/chunk.hpp"
+#include "drivers/protocol/messages.hpp"
+#include "drivers/protocol/modbus_map.hpp"
+#include "drivers/transport.hpp"
+
+extern char** environ;
+
+namespace {
+
+namespace mb = hybridctl::protocol::modbus;
+using namespace hybridctl;
+using namespace hybridctl::protocol;
+
+constexpr int kCpu = 0;
+
+void pin(pid_t pid) {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  CPU_SET(kCpu, &set);
+  if (sched_setaffinity(pid, sizeof set, &set) != 0) std::perror("sched_setaffinity");
+}
+
+// `hybridctl sim serve` on a free port, pinned, for the whole run.
+struct Simulator {
+  pid_t pid = -1;
+  int port = 0;
+
+  Simulator() {
+    int fds[2];
+    if (::pipe(fds) != 0) throw std::runtime_error("pipe");
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, fds[1], 1);
+    posix_spawn_file_actions_addclose(&actions, fds[0]);
+    const std::string machine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/hybrid-3axis.yaml";
+    std::vector<std::string> args = {HYBRIDCTL_EXE, "sim",          "serve", "--machine",           machine,
+                                     "--modbus",    "tcp://127.0.0.1:0", "--time-scale", "0", "--heartbeat-timeout",
+                                     "0"};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    if (posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ) != 0)
+      throw std::runtime_error("cannot start " + args[0]);
+    posix_spawn_file_actions_destroy(&actions);
+    ::close(fds[1]);
+    pin(pid);
+    std::string out;
+    char buffer[256];
+    while (out.find("ready\n") == std::string::npos) {
+      pollfd p{fds[0], POLLIN, 0};
+      if (::poll(&p, 1, 20000) <= 0) throw std::runtime_error("the simulator printed no 'ready' line");
+      const ssize_t n = ::read(fds[0], buffer, sizeof buffer);
+      if (n <= 0) throw std::runtime_error("the simulator exited: " + out);
+      out.append(buffer, static_cast<std::size_t>(n));
+    }
+    ::close(fds[0]);
+    const std::string key = "listening modbus-tcp 127.0.0.1:";
+    port = std::stoi(out.substr(out.find(key) + key.size()));
+  }
+  ~Simulator() {
+    if (pid > 0) {
+      ::kill(pid, SIGTERM);
+      ::waitpid(pid, nullptr, 0);
+    }
+  }
+};
+
+Simulator& simulator() {
+  static Simulator sim;
+  return sim;
+}
+
+// ~28-byte feed moves inside the example machine's travel. No M2: the benchmark sets the
+// program again when it ran out (the simulated controller keeps an ended interpreter
+// across SET_PROGRAM).
+std::vector<std::string> program(int moves) {
+  std::string p = "G21 G90 G17\nG54\nT1 M6\nS8000 M3\nG0 X0 Y0 Z20\n";
+  char line[64];
+  for (int i = 0; i < moves; ++i) {
+    std::snprintf(line, sizeof line, "G1 X%.3f Y%.3f Z20 F1200\n", 10 + (i * 7919LL % 40000) / 1000.0,
+                  10 + (i * 104729LL % 20000) / 1000.0);
+    p += line;
+  }
+  return program_lines(p);
+}
+
+const std::vector<std::string>& lines() {
+  static const std::vector<std::string> l = program(200000);
+  return l;
+}
+
+// The chunks of the program, made once (both loops send the same ones).
+const std::vector<Chunk>& chunks() {
+  static const std::vector<Chunk> c = [] {
+    std::vector<Chunk> out;
+    const std::uint64_t identity = program_identity(lines());
+    std::uint32_t line = 1;
+    for (std::uint32_t seq = 1; line <= lines().size(); ++seq) {
+      out.push_back(*make_chunk(lines(), line, seq, identity, mb::kMaxChunkPayload));
+      line += out.back().line_count;
+    }
+    return out;
+  }();
+  return c;
+}
+
+struct Rates {
+  double requests = 0;
+  double lines = 0;
+};
+Rates g_transport, g_bare;
+
+// One benchmark loop over a "send the chunk, get the status" function.
+// `command(code, seq)` sends a command. The program is (re)set before the loop and
+// whenever it ran out (ABORT first: the other loop may have left it running).
+template <class Send, class Command>
+void chunk_loop(benchmark::State& state, Send&& send, Command&& command) {
+  const auto& cs = chunks();
+  std::uint16_t command_seq = 0;
+  command(CommandCode::Abort, ++command_seq);
+  command(CommandCode::SetProgram, ++command_seq);
+  command(CommandCode::Start, ++command_seq);
+  std::size_t next = 0;
+  std::uint64_t requests = 0, lines_sent = 0, buffer_full = 0;
+  for (auto _ : state) {
+    if (next == cs.size()) {  // the program is done: set it again
+      state.PauseTiming();
+      command(CommandCode::Abort, ++command_seq);
+      command(CommandCode::SetProgram, ++command_seq);
+      command(CommandCode::Start, ++command_seq);
+      next = 0;
+      state.ResumeTiming();
+    }
+    const Chunk& chunk = cs[next];
+    const Status s = send(chunk);
+    ++requests;
+    if (s.last_written_chunk == chunk.seq &&
+        (s.chunk_result == ResultCode::Accepted || s.chunk_result == ResultCode::Duplicate)) {
+      lines_sent += chunk.line_count;
+      ++next;
+    } else if (s.chunk_result == ResultCode::BufferFull) {
+      ++buffer_full;  // the controller has not executed enough yet: send it again
+    } else {
+      state.SkipWithError(("chunk " + std::to_string(chunk.seq) + ": " + std::string(to_string(s.chunk_result)) +
+                           " in state " + std::string(to_string(s.state)))
+                              .c_str());
+      break;
+    }
+  }
+  state.counters["requests/s"] = benchmark::Counter(double(requests), benchmark::Counter::kIsRate);
+  state.counters["lines/s"] = benchmark::Counter(double(lines_sent), benchmark::Counter::kIsRate);
+  state.counters["buffer_full"] = double(buffer_full);
+  state.SetItemsProcessed(static_cast<std::int64_t>(requests));
+}
+
+void BM_TransportSendChunk(benchmark::State& state) {
+  pin(0);
+  auto t = drivers::open_transport("modbus-tcp://127.0.0.1:" + std::to_string(simulator().port));
+  const std::uint64_t identity = program_identity(lines());
+  chunk_loop(
+      state, [&](const Chunk& c) { return t->send_chunk(c); },
+      [&](CommandCode code, std::uint16_t seq) {
+        t->send_command(Command{code, static_cast<std::uint16_t>(seq + 1000), code == CommandCode::SetProgram ? identity : 0,
+                                code == CommandCode::SetProgram ? static_cast<std::uint32_t>(lines().size()) : 0u});
+      });
+  const auto c = t->counters();
+  state.counters["retries"] = double(c.retries);
+}
+
+void BM_BareLibmodbusFc23(benchmark::State& state) {
+  pin(0);
+  modbus_t* ctx = modbus_new_tcp("127.0.0.1", simulator().port);
+  modbus_set_response_timeout(ctx, 2, 0);
+  if (modbus_connect(ctx) != 0) {
+    state.SkipWithError(modbus_strerror(errno));
+    modbus_free(ctx);
+    return;
+  }
+  const std::uint64_t identity = program_identity(lines());
+  // Encoded once per chunk, outside the loop: the baseline is libmodbus alone.
+  std::vector<std::vector<std::uint16_t>> mailboxes;
+  for (const Chunk& c : chunks()) mailboxes.push_back(*mb::encode_mailbox(c));
+  std::uint16_t regs[mb::kStatusCount];
+  chunk_loop(
+      state,
+      [&](const Chunk& c) {
+        const auto& m = mailboxes[c.seq - 1];
+        Status s;
+        if (modbus_write_and_read_registers(ctx, mb::kMailboxAddress, int(m.size()), m.data(), mb::kStatusMirrorAddress,
+                                            mb::kStatusCount, regs) != int(mb::kStatusCount))
+          return s;  // reported by the loop as an unexpected result
+        // The two fields the loop needs, straight from the registers.
+        s.chunk_result = static_cast<ResultCode>(regs[status_reg::kChunkResult]);
+        s.last_written_chunk = (std::uint32_t(regs[status_reg::kLastWrittenChunk]) << 16) |
+                               regs[status_reg::kLastWrittenChunk + 1];
+        return s;
+      },
+      [&](CommandCode code, std::uint16_t seq) {
+        const CommandRegisters r =
+            encode_command(Command{code, static_cast<std::uint16_t>(seq + 2000), code == CommandCode::SetProgram ? identity : 0,
+                                   code == CommandCode::SetProgram ? static_cast<std::uint32_t>(lines().size()) : 0u});
+        modbus_write_registers(ctx, mb::kCommandAddress, mb::kCommandCount, r.data());
+      });
+  modbus_close(ctx);
+  modbus_free(ctx);
+}
+
+// Keeps each benchmark's rates for the ratio printed at the end.
+class RateReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const Run& r : runs) {
+      if (r.error_occurred) continue;
+      Rates* rates = r.benchmark_name().find("Transport") != std::string::npos ? &g_transport : &g_bare;
+      if (auto it = r.counters.find("requests/s"); it != r.counters.end()) rates->requests = it->second;
+      if (auto it = r.counters.find("lines/s"); it != r.counters.end()) rates->lines = it->second;
+    }
+    ConsoleReporter::ReportRuns(runs);
+  }
+};
+
+}  // namespace
+
+BENCHMARK(BM_BareLibmodbusFc23)->MinTime(2.0)->UseRealTime();
+BENCHMARK(BM_TransportSendChunk)->MinTime(2.0)->UseRealTime();
+
+int main(int argc, char** argv) {
+  std::signal(SIGPIPE, SIG_IGN);
+  benchmark::Initialize(&argc, argv);
+  RateReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  if (g_transport.requests > 0 && g_bare.requests > 0) {
+    std::printf("\nModbusTransport::send_chunk / bare libmodbus FC23, same simulator, both pinned to CPU %d:\n", kCpu);
+    std::printf("  %.0f / %.0f requests/s = %.2f\n", g_transport.requests, g_bare.requests,
+                g_transport.requests / g_bare.requests);
+    std::printf("  %.0f / %.0f lines/s (~28-byte lines, chunks up to 222 bytes)\n", g_transport.lines, g_bare.lines);
+  }
+  benchmark::Shutdown();
+  return 0;
+}
