@@ -13,7 +13,8 @@ int main(int argc, char** argv) {
       "hybridctl plans hybrid manufacturing (metal deposition and milling on one machine)\n"
       "from a part (STL) and a machine description (YAML).\n\n"
       "Exit codes: 0 success, 1 internal error, 2 usage error, 3 bad input (file, YAML, STL, G-code),\n"
-      "4 part not manufacturable with the machine's primitives (plan).",
+      "4 part not manufacturable with the machine's primitives (plan), 5 the machine stopped before\n"
+      "the program's end (run), 6 the controller could not be reached (run, status).",
       "hybridctl"};
   app.set_version_flag("--version", "hybridctl 0.1.0");
   app.require_subcommand(1);
