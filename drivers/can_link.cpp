@@ -147,7 +147,6 @@ auto CanTransport::run(const std::string& what, Once&& once) {
       io_->close();
       issue = Issue{Kind::Disconnected, e.what()};
     }
-    if (segmenter_) segmenter_ = nullptr;
     if (issue->kind == Kind::Timeout) ++counters_.timeouts;
     if (issue->kind == Kind::Protocol) ++counters_.bad_replies;
     if (resends >= options_.request_retries)
@@ -205,6 +204,10 @@ protocol::Status CanTransport::send_chunk(const protocol::Chunk& chunk) {
     if (auto error = segmenter.begin(message.value(), can::chunk_transfer_id(chunk.seq), now_micros()))
       throw InputError(describe() + ": " + what + ": " + error->message);
     segmenter_ = &segmenter;
+    struct Unhook {  // the segmenter lives in this scope only, however it is left
+      can::CanSegmenter*& hook;
+      ~Unhook() { hook = nullptr; }
+    } unhook{segmenter_};
     std::vector<can::CanFrame> batch;
     while (true) {
       const can::Micros now = now_micros();
@@ -222,7 +225,6 @@ protocol::Status CanTransport::send_chunk(const protocol::Chunk& chunk) {
                                       : SteadyClock::now() + milliseconds{20};
       if (auto frame = io_->receive(deadline)) dispatch(*frame);
     }
-    segmenter_ = nullptr;
     if (segmenter.state() == can::CanSegmenter::State::Failed) {
       const auto& error = segmenter.error();
       const bool timeout = error && (error->kind == can::TransferErrorKind::Timeout ||
