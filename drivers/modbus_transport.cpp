@@ -201,20 +201,22 @@ struct ModbusTransport::Impl {
         case Kind::Protocol: ++counters.bad_replies; break;
         default: break;
       }
-      if (issue->recovery == Recovery::GiveUp || resends >= options.request_retries)
+      const bool last = issue->recovery == Recovery::GiveUp || resends >= options.request_retries;
+      switch (issue->recovery) {
+        // After a timeout too: a late reply must not pass for the next request's. Done
+        // before giving up as well, so the next call starts in step.
+        case Recovery::Resync: resync(); break;
+        case Recovery::Reconnect: disconnect(); break;
+        case Recovery::Resend:  // a busy controller: give it a moment
+          if (!last) std::this_thread::sleep_for(std::min(options.reconnect_backoff, milliseconds{100}));
+          break;
+        case Recovery::GiveUp: break;
+      }
+      if (last)
         throw TransportError(issue->kind, describe() + ": " + what() + ": " + issue->message +
                                               (resends ? " (after " + std::to_string(resends) + " resend" +
                                                              (resends == 1 ? "" : "s") + ")"
                                                        : std::string()));
-      switch (issue->recovery) {
-        case Recovery::Resync: resync(); break;  // after a timeout too: a late reply must not pass for the next one
-        case Recovery::Reconnect: disconnect(); break;
-        case Recovery::Resend:
-          // A busy controller: give it a moment.
-          std::this_thread::sleep_for(std::min(options.reconnect_backoff, milliseconds{100}));
-          break;
-        case Recovery::GiveUp: break;
-      }
       ++resends;
       ++counters.retries;
     }
