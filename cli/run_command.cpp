@@ -70,6 +70,9 @@ std::string operator_message(const std::vector<std::string>& lines, std::uint32_
 }  // namespace
 
 int run_job(const RunRequest& request) {
+  // Ctrl-C holds the feed (and asks) once streaming runs; before that it is noted too.
+  interrupted = false;
+  std::signal(SIGINT, on_sigint);
   // What to run: a resumed job's program, a program file, or a plan exported now.
   drivers::JournalHeader header;
   std::optional<drivers::Journal> journal;
@@ -138,7 +141,6 @@ int run_job(const RunRequest& request) {
   const bool tty = ::isatty(STDERR_FILENO) == 1;
   const auto begun = Clock::now();
   auto last_print = Clock::now() - std::chrono::seconds(10);
-  std::signal(SIGINT, on_sigint);
 
   drivers::StreamCallbacks cb;
   cb.status = [&](const protocol::Status& s) {

@@ -189,6 +189,29 @@ TEST_F(Run, AHostKilledMidProgramResumesFromItsJournal) {
   EXPECT_NE(slurp(dir_ / "run.err").find("resuming: the controller executed through line"), std::string::npos);
 }
 
+TEST_F(Run, CtrlCHoldsTheFeedAndWithoutAnOperatorAborts) {
+  int port = 0;
+  auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "2000"}, "modbus-tcp", port, false);
+  Background host(command({"run", plan().string(), "--machine", kMachine, "--transport",
+                           "modbus-tcp://127.0.0.1:" + std::to_string(port), "--job", (dir_ / "job").string(), "--yes"}),
+                  dir_, "host");
+  // Once it streams (its status line says RUNNING), Ctrl-C.
+  for (int i = 0; i < 200 && slurp(dir_ / "host.err").find("RUNNING") == std::string::npos; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  ASSERT_TRUE(host.alive());
+  ::kill(host.pid, SIGINT);
+  host.wait_exit(10);
+  EXPECT_FALSE(host.alive());
+  // No terminal to ask: the hold becomes an abort, said as such.
+  const std::string out = slurp(dir_ / "host.out"), err = slurp(dir_ / "host.err");
+  EXPECT_NE(err.find("feed hold (Ctrl-C)"), std::string::npos) << err;
+  EXPECT_NE(out.find("STOPPED after"), std::string::npos) << out;
+  EXPECT_NE(out.find("the program was aborted"), std::string::npos) << out;
+  // The controller stopped where it was: fewer lines than the program.
+  const std::string log = slurp(dir_ / "lines.ngc.tmp"), program = slurp(dir_ / "job" / "program.ngc");
+  EXPECT_LT(log.size(), program.size());
+}
+
 TEST_F(Run, AResumeIntoAnotherProgramIsRefused) {
   int port = 0;
   auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "0"}, "modbus-tcp", port, false);
