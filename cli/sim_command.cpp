@@ -15,6 +15,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
+#include "drivers/protocol/can_transfer.hpp"
+#include "drivers/protocol/modbus_map.hpp"
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
@@ -233,6 +235,11 @@ int serve(const ServeRequest& r) {
   sim::ControllerOptions options;
   options.time_scale = r.time_scale;
   options.buffer_bytes = r.buffer_bytes;
+  // Over CAN alone, chunks may be as large as a CAN transfer carries (fewer round trips);
+  // with a Modbus endpoint, as large as its mailbox.
+  options.max_chunk_payload = r.modbus.empty() && r.modbus_rtu.empty()
+                                  ? std::uint16_t(std::min<std::size_t>(protocol::can::kMaxChunkPayload, r.buffer_bytes))
+                                  : std::uint16_t(protocol::modbus::kMaxChunkPayload);
   options.heartbeat_timeout_s = r.heartbeat_timeout_s;
   options.alarm_at_line = faults.alarm_at_line;
   // A reboot lands right after its line: advance() stops there.

@@ -44,7 +44,7 @@ struct Controller::Impl {
   Impl(const config::Machine& m, ControllerOptions o)
       : machine(m),
         options(std::move(o)),
-        acceptor({options.buffer_bytes, protocol::modbus::kMaxChunkPayload}) {
+        acceptor({options.buffer_bytes, options.max_chunk_payload}) {
     ExecutorOptions eo;
     eo.stock = options.stock;
     eo.protected_region = options.protected_region;
@@ -323,7 +323,7 @@ void Controller::reboot() {
   // position, tool and modal state (the executor: the controller restores them for a
   // mid-program restart), and the material. Lost: the queue and the chunk in hand.
   protocol::SafePoint safe{i.acceptor.identity(), i.acceptor.line_count(), i.last_executed_chunk, i.last_executed_line};
-  protocol::ChunkAcceptor fresh({i.options.buffer_bytes, protocol::modbus::kMaxChunkPayload});
+  protocol::ChunkAcceptor fresh({i.options.buffer_bytes, i.options.max_chunk_payload});
   if (i.acceptor.has_program()) fresh.restore(safe);
   i.acceptor = std::move(fresh);
   i.chunk.reset();

@@ -35,6 +35,9 @@ struct ControllerOptions {
   // runs what is queued, up to max_lines_per_advance lines).
   double time_scale = 0;
   std::uint32_t buffer_bytes = 16384;  // program buffer (payload bytes)
+  // The largest chunk payload accepted and advertised: what one Modbus mailbox write
+  // carries by default; a controller reached only over CAN takes CAN's larger transfers.
+  std::uint16_t max_chunk_payload = 222;
   double heartbeat_timeout_s = 2.0;    // RUNNING without a heartbeat change -> feed hold + alarm
   std::uint32_t max_lines_per_advance = 2000;
   // The stock the material simulation starts from (part frame), and the region it must
