@@ -57,6 +57,7 @@ struct ServeRequest {
   int node = 1;
   std::uint32_t can_bitrate = 0;
   int status_period_ms = 50;
+  int can_block_size = 8;
   double time_scale = 1.0;
   std::uint32_t buffer_bytes = 16384;
   double heartbeat_timeout_s = 2.0;
@@ -270,6 +271,7 @@ int serve(const ServeRequest& r) {
   sim::CanNodeOptions node;
   node.node = static_cast<std::uint8_t>(r.node);
   node.status_period = std::chrono::milliseconds(r.status_period_ms);
+  node.reassembler.block_size = static_cast<std::uint8_t>(r.can_block_size);
   sim::ModbusServerOptions modbus_options;
   modbus_options.faults = faults;
   modbus_options.debug = r.modbus_debug;
@@ -497,6 +499,10 @@ void add_sim_command(CLI::App& app, Runner& runner) {
   serve_cmd->add_option("--can-bitrate", r->can_bitrate,
                         "socketcand: pace frames as a CAN bus at this bit rate would (e.g. 1000000; 0: no pacing)")
       ->capture_default_str();
+  serve_cmd->add_option("--can-block-size", r->can_block_size,
+                        "CAN: consecutive frames the host may send per flow control (0: a whole chunk at once)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 255));
   serve_cmd->add_option("--status-period-ms", r->status_period_ms, "CAN: a status snapshot at least this often")
       ->capture_default_str()
       ->check(CLI::Range(1, 60000));
