@@ -212,6 +212,36 @@ TEST_F(Run, CtrlCHoldsTheFeedAndWithoutAnOperatorAborts) {
   EXPECT_LT(log.size(), program.size());
 }
 
+TEST_F(Run, ASetupChangeStopsForTheOperatorAndGoesOnWhenAcknowledged) {
+  // The thin-wall slot's best plan mills from below, then from above: the part is turned
+  // over by hand in between (manual_refixture), a program stop with the operator's message.
+  const fs::path plan_dir = dir_ / "slot";
+  ASSERT_EQ(std::system((command({"plan", (kSource / "examples/parts/thin-wall-slot.stl").string(), "--machine", kMachine,
+                                   "--voxel", "0.5", "--top", "1", "-o", plan_dir.string()}) +
+                         " >/dev/null 2>&1")
+                            .c_str()),
+            0);
+  std::vector<std::string> args = {"sim", "serve", "--machine", kMachine, "--stock", (plan_dir / "plan.json").string(),
+                                   "--exit-when-done", "--line-log", (dir_ / "lines.ngc").string(), "--modbus",
+                                   "tcp://127.0.0.1:0", "--time-scale", "0"};
+  Background sim(command(args), dir_, "sim");
+  int port = 0;
+  for (int i = 0; i < 100 && !port; ++i) {
+    std::smatch m;
+    const std::string out = slurp(dir_ / "sim.out");
+    if (std::regex_search(out, m, std::regex("listening modbus-tcp 127\\.0\\.0\\.1:([0-9]+)"))) port = std::stoi(m[1]);
+    if (!port) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_GT(port, 0);
+  EXPECT_EQ(run({"run", (plan_dir / "plan.json").string(), "--machine", kMachine, "--transport",
+                 "modbus-tcp://127.0.0.1:" + std::to_string(port), "--job", (dir_ / "job").string(), "--yes"}),
+            0)
+      << slurp(dir_ / "run.err");
+  const std::string err = slurp(dir_ / "run.err");
+  EXPECT_NE(err.find("program stop after line"), std::string::npos) << err;
+  expect_exactly_once(sim);
+}
+
 TEST_F(Run, AResumeIntoAnotherProgramIsRefused) {
   int port = 0;
   auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "0"}, "modbus-tcp", port, false);
