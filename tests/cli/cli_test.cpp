@@ -7,6 +7,8 @@
 #include <unistd.h>
 
 #include <cstring>
+#include "shell.hpp"
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -18,23 +20,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Outcome {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
+using hybridctl::cli_testing::Outcome;
+using hybridctl::cli_testing::quote;
+using hybridctl::cli_testing::slurp;
 
 class Cli : public ::testing::Test {
  protected:
@@ -48,13 +36,7 @@ class Cli : public ::testing::Test {
   Outcome run(const std::vector<std::string>& args) {
     std::string cmd = quote(HYBRIDCTL_EXE);
     for (const auto& a : args) cmd += " " + quote(a);
-    cmd += " >" + quote((dir_ / "stdout").string()) + " 2>" + quote((dir_ / "stderr").string()) + " </dev/null";
-    const int status = std::system(cmd.c_str());
-    Outcome r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    r.out = slurp(dir_ / "stdout");
-    r.err = slurp(dir_ / "stderr");
-    return r;
+    return hybridctl::cli_testing::run_shell(cmd, dir_);
   }
 
   fs::path write(const std::string& name, const std::string& bytes) {

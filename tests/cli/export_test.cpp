@@ -6,6 +6,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "shell.hpp"
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -16,23 +18,9 @@ namespace fs = std::filesystem;
 
 const fs::path kSource = HYBRIDCTL_SOURCE_DIR;
 
-struct Outcome {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
+using hybridctl::cli_testing::Outcome;
+using hybridctl::cli_testing::quote;
+using hybridctl::cli_testing::slurp;
 
 class Export : public ::testing::Test {
  protected:
@@ -44,15 +32,7 @@ class Export : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  Outcome sh(const std::string& command) {
-    const std::string cmd = command + " >" + quote((dir_ / "stdout").string()) + " 2>" + quote((dir_ / "stderr").string()) + " </dev/null";
-    const int status = std::system(cmd.c_str());
-    Outcome r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    r.out = slurp(dir_ / "stdout");
-    r.err = slurp(dir_ / "stderr");
-    return r;
-  }
+  Outcome sh(const std::string& command) { return hybridctl::cli_testing::run_shell(command, dir_); }
   Outcome hybridctl(const std::vector<std::string>& args) {
     std::string cmd = quote(HYBRIDCTL_EXE);
     for (const auto& a : args) cmd += " " + quote(a);

@@ -8,6 +8,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "shell.hpp"
+
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -21,18 +23,8 @@ namespace fs = std::filesystem;
 const fs::path kSource = HYBRIDCTL_SOURCE_DIR;
 const std::string kMachine = (kSource / "examples/machines/hybrid-3axis.yaml").string();
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
+using hybridctl::cli_testing::quote;
+using hybridctl::cli_testing::slurp;
 
 std::string command(const std::vector<std::string>& args) {
   std::string cmd = quote(HYBRIDCTL_EXE);

@@ -124,12 +124,12 @@ TEST(ToolpathsInTheSimulation, AStepDownDeeperThanTheFlutesIsCutToTheFluteLength
   const Solid stock = box({{0, 0, 0}, {20, 16, 8}});
   const Solid roi = box({{4, 4, 0.5}, {16, 12, 8}});
   const Solid keep = geometry::subtract(stock, roi);
-  config::CuttingTool stubby = flat_4mm();
-  stubby.flute_length = 1.5;
-  stubby.shank = {4, 10};
+  config::CuttingTool short_flute = flat_4mm();
+  short_flute.flute_length = 1.5;
+  short_flute.shank = {4, 10};
   PocketOptions o;
   o.step_down = 4;
-  const Toolpath p = pocket_path(roi, keep, stock, stubby, top, o);
+  const Toolpath p = pocket_path(roi, keep, stock, short_flute, top, o);
   bool warned = false;
   for (const auto& w : p.warnings) warned = warned || w.find("more than the flute length") != std::string::npos;
   EXPECT_TRUE(warned);
@@ -146,7 +146,7 @@ TEST(ToolpathsInTheSimulation, AStepDownDeeperThanTheFlutesIsCutToTheFluteLength
   sim::MaterialSimulation s(world, keep);
   geometry::Vec3 at = p.start;
   for (std::size_t i = 0; i < p.moves.size(); ++i) {
-    s.cut(sim::cutter_of(stubby), {motion_of(p.moves[i].kind), at, p.moves[i].to, {}, p.moves[i].process_on, int(i + 1)});
+    s.cut(sim::cutter_of(short_flute), {motion_of(p.moves[i].kind), at, p.moves[i].to, {}, p.moves[i].process_on, int(i + 1)});
     at = p.moves[i].to;
   }
   EXPECT_EQ(count(s.report(), sim::IncidentKind::BodyCollision), 0) << incidents(s.report());

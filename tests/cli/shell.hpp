@@ -1,0 +1,46 @@
+#pragma once
+// What the CLI tests share: running hybridctl (or any command) through the shell and
+// reading back what it wrote.
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace hybridctl::cli_testing {
+
+struct Outcome {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// One argument for /bin/sh, single-quoted.
+inline std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// Runs `command` with its output in DIR/stdout and DIR/stderr and stdin from /dev/null.
+inline Outcome run_shell(const std::string& command, const std::filesystem::path& dir) {
+  const std::string cmd = command + " >" + quote((dir / "stdout").string()) + " 2>" + quote((dir / "stderr").string()) +
+                          " </dev/null";
+  const int status = std::system(cmd.c_str());
+  Outcome r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.out = slurp(dir / "stdout");
+  r.err = slurp(dir / "stderr");
+  return r;
+}
+
+}  // namespace hybridctl::cli_testing
