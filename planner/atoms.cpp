@@ -76,7 +76,10 @@ void AtomDecomposition::add_primitive(const Solid& primitive) {
   tbb::combinable<std::pair<Counts, Counts>> partial([&] { return std::make_pair(Counts(old_count, 0), Counts(old_count, 0)); });
   const int x0 = domain_.lo.x, x1 = domain_.hi.x;
   for_each_row(domain_, [&](std::size_t first, int y, int z) {
-    auto& [inside, size] = partial.local();
+    // Plain references, not a structured binding: clang 14 cannot capture those in a lambda.
+    auto& counts = partial.local();
+    auto& inside = counts.first;
+    auto& size = counts.second;
     const std::int32_t* row = labels_.data() + first;
     for (int i = 0; i < x1 - x0; ++i) ++size[std::size_t(row[i])];
     for_each_set_in_row(primitive, y, z, x0, x1, [&](int x) { ++inside[std::size_t(row[x - x0])]; });
