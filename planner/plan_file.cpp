@@ -100,10 +100,17 @@ PlanFile read_plan_file(const fs::path& given) {
   if (!in) throw InputError(name + ": cannot read: no such file (expected a plan.json written by `hybridctl plan`)");
   std::stringstream buffer;
   buffer << in.rdbuf();
+  return parse_plan_file(buffer.str(), json_path);
+}
+
+PlanFile parse_plan_file(std::string_view json_text, const fs::path& json_path) {
+  const std::string name = json_path.string();
   json root;
   try {
-    root = json::parse(buffer.str());
-  } catch (const json::parse_error& e) {
+    root = json::parse(json_text);
+  } catch (const json::exception& e) {
+    // A syntax error (parse_error, with the place) or a number beyond a double's range
+    // (out_of_range 406, naming the number).
     throw InputError(name + ": not JSON: " + e.what());
   }
   const Node top(root, name, "");

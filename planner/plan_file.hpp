@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "geometry/solid.hpp"
@@ -54,6 +55,9 @@ struct PlanFile {
 // mistyped or inconsistent (unknown version, a plan naming a primitive that does not
 // exist, a .vdb on another grid).
 PlanFile read_plan_file(const std::filesystem::path& plan_json_or_directory);
+// The same from the text of a plan.json that stands at `json_path` (used in messages; the
+// .vdb files are read from its directory, the file itself is not read).
+PlanFile parse_plan_file(std::string_view json_text, const std::filesystem::path& json_path);
 
 // The states a plan passes through on the voxels: states[0] is empty, states[k] the
 // material after action k (AM unites, SM subtracts), clipped to the domain.
