@@ -544,7 +544,14 @@ void Interpreter::run(const Block& b, ModalState& s) {
     if (b.has('C')) rot.c = s.absolute || machine_coords.code >= 0 ? b.value('C') : rot.c + b.value('C');
     m.to_machine = to;
     m.to_rotary = rot;
-    const int motion_column = motion.code >= 0 ? motion.column : first_axis_column;
+    // With no motion code on the line, its first axis word stands for the motion; a modal
+    // G2/G3 line may hold only arc words (a full circle: I J K; or R), then the first of those.
+    int first_motion_word_column = first_axis_column;
+    if (arc_mode && first_motion_word_column == 0)
+      for (char L : {'I', 'J', 'K', 'R'})
+        if (b.has(L) && (first_motion_word_column == 0 || b.column(L) < first_motion_word_column))
+          first_motion_word_column = b.column(L);
+    const int motion_column = motion.code >= 0 ? motion.column : first_motion_word_column;
     if (m.kind != MotionKind::Rapid) {
       if (s.feed <= 0)
         fail(b, motion_column,

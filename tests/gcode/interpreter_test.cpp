@@ -110,6 +110,10 @@ TEST(Interpreter, FeedMovesNeedAFeed) {
   expect_error({"G1 X10"}, "t.ngc:1:1: ", "G1 with zero feed rate; expected an F word greater than 0");
   expect_error({"G0 X1", "X5 G1 F0"}, "t.ngc:2:4: ", "zero feed rate");
   expect_error({"G3 X1 Y1 R1"}, "t.ngc:1:1: ", "G3 with zero feed rate");
+  // Found by fuzz/gcode_fuzz (fuzz/corpus/gcode/regression-arc-words-only.ngc): a modal G2
+  // line with only arc words was refused at column 0; its first arc word stands for the motion.
+  expect_error({"G2", "R0"}, "t.ngc:2:1: ", "G2 with zero feed rate");
+  expect_error({"G3", "  J2 I1"}, "t.ngc:2:3: ", "G3 with zero feed rate");
 }
 
 TEST(Interpreter, ModalGroupConflictsAndUnknownCodes) {
