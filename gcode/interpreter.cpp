@@ -14,6 +14,11 @@ constexpr double kRadiusTolerance = 0.00127;
 /// Two in-plane points closer than this are the same point (a full circle).
 constexpr double kSamePoint = 1e-9;
 constexpr int kMaxHeads = 32;
+/// T, H, P (output) and E (analog output) numbers are whole numbers from 0 to this.
+constexpr double kMaxNumberWord = 99999;
+
+/// Whether a T, H, P or E value is such a number (and so fits an int).
+bool number_word(double v) { return v >= 0 && v <= kMaxNumberWord && v == std::nearbyint(v); }
 
 std::string fmt(double v) {
   char buf[32];
@@ -104,6 +109,9 @@ Interpreter::Interpreter(const config::Machine& machine, std::string file_name, 
                          ": expected one M code with optional P, E, Q or S words, such as 'M64 P0'");
       HeadCode hc;
       hc.m = code.m[0].value;
+      if (code.has('P') && !number_word(code.value('P')))
+        throw InputError("machine " + machine.name + ": " + what +
+                         ": expected the output number P to be a whole number from 0 to 99999");
       hc.p = code.has('P') ? static_cast<int>(code.value('P')) : -1;
       hc.head = static_cast<int>(i);
       hc.on = on;
@@ -282,7 +290,8 @@ void Interpreter::run(const Block& b, ModalState& s) {
   int tool_after_change = s.tool;
   for (int i = 0; i < b.m_count; ++i)
     if (role_of(b.m[i].value) == MRole::ToolChange)
-      tool_after_change = b.has('T') ? int(b.value('T')) : s.selected_tool;
+      // (a T that is no tool number is refused below, with its column)
+      tool_after_change = !b.has('T') ? s.selected_tool : number_word(b.value('T')) ? int(b.value('T')) : -1;
   for (int i = 0; i < b.m_count; ++i) {
     const Code c = b.m[i];
     MAction a;
@@ -355,8 +364,8 @@ void Interpreter::run(const Block& b, ModalState& s) {
   }
   if (b.has('T')) {
     const double t = b.value('T');
-    if (t < 0 || t != std::nearbyint(t) || t > 99999)
-      fail(b, b.column('T'), "found T" + fmt(t) + "; expected a tool number, a whole number from 0");
+    if (!number_word(t))
+      fail(b, b.column('T'), "found T" + fmt(t) + "; expected a tool number, a whole number from 0 to 99999");
     s.selected_tool = static_cast<int>(t);
     used |= bit('T');
   }
@@ -420,9 +429,10 @@ void Interpreter::run(const Block& b, ModalState& s) {
              "found " + m_code_name(a.io) + " with no P word; expected the output number, e.g. " + m_code_name(a.io) +
                  " P0");
       const double p = b.value('P');
-      if (p < 0 || p != std::nearbyint(p))
+      if (!number_word(p))
         fail(b, b.column('P'),
-             "found P" + fmt(p) + " with " + m_code_name(a.io) + "; expected an output number, a whole number from 0");
+             "found P" + fmt(p) + " with " + m_code_name(a.io) +
+                 "; expected an output number, a whole number from 0 to 99999");
       used |= bit('P');
       Event& e = event(EventKind::DigitalOutput, a.column);
       e.index = static_cast<int>(p);
@@ -433,8 +443,9 @@ void Interpreter::run(const Block& b, ModalState& s) {
              "found " + m_code_name(a.io) + " without " + (b.has('E') ? "Q" : "E") +
                  "; expected the output number E and its value Q, e.g. " + m_code_name(a.io) + " E0 Q800");
       const double e_number = b.value('E');
-      if (e_number < 0 || e_number != std::nearbyint(e_number))
-        fail(b, b.column('E'), "found E" + fmt(e_number) + "; expected an analog output number, a whole number");
+      if (!number_word(e_number))
+        fail(b, b.column('E'),
+             "found E" + fmt(e_number) + "; expected an analog output number, a whole number from 0 to 99999");
       used |= bit('E') | bit('Q');
       Event& e = event(EventKind::AnalogOutput, a.column);
       e.index = static_cast<int>(e_number);
@@ -466,8 +477,8 @@ void Interpreter::run(const Block& b, ModalState& s) {
     if (!b.has('H'))
       fail(b, length.column, "found G43 with no H word; expected the tool length offset number, e.g. G43 H1");
     const double h = b.value('H');
-    if (h < 0 || h != std::nearbyint(h))
-      fail(b, b.column('H'), "found H" + fmt(h) + "; expected a tool number, a whole number from 0");
+    if (!number_word(h))
+      fail(b, b.column('H'), "found H" + fmt(h) + "; expected a tool number, a whole number from 0 to 99999");
     s.tool_length_offset = static_cast<int>(h);
     used |= bit('H');
   } else if (length.code == 490) {

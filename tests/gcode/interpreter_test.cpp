@@ -430,6 +430,30 @@ TEST(Interpreter, HeadCodesTheInterpreterCannotRecogniseAreRefused) {
   Machine m = machine();
   m.heads[0].codes.on = "G1 X1";
   EXPECT_THROW(Interpreter{m}, hybridctl::InputError);
+  // An output number beyond an int was converted to one (undefined behaviour, found with
+  // UBSan by fuzz/gcode_fuzz); a fraction was cut off.
+  for (const char* on : {"M64 P99999999999", "M64 P1.5"}) {
+    m.heads[0].codes.on = on;
+    try {
+      Interpreter in(m);
+      ADD_FAILURE() << on << " was taken";
+    } catch (const hybridctl::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("heads[0].codes.on '" + std::string(on) +
+                                           "': expected the output number P to be a whole number from 0 to 99999"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}
+
+TEST(Interpreter, NumberWordsBeyondAnIntAreRefusedAtTheirColumn) {
+  // Found by fuzz/gcode_fuzz (fuzz/corpus/gcode/regression-number-words.ngc): T, H, P and
+  // E values beyond an int were converted to one, undefined behaviour that UBSan reports.
+  expect_error({"M64 P100000000000"}, "t.ngc:1:5: ", "found P100000000000 with M64; expected an output number, a whole number from 0 to 99999");
+  expect_error({"M62 P100000"}, "t.ngc:1:5: ", "a whole number from 0 to 99999");
+  expect_error({"M68 E10000000000 Q1"}, "t.ngc:1:5: ", "found E10000000000; expected an analog output number, a whole number from 0 to 99999");
+  expect_error({"G43 H10000000000"}, "t.ngc:1:5: ", "found H10000000000; expected a tool number, a whole number from 0 to 99999");
+  expect_error({"T10000000000 M6"}, "t.ngc:1:1: ", "found T10000000000; expected a tool number, a whole number from 0 to 99999");
 }
 
 }  // namespace
