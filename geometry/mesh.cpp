@@ -16,11 +16,14 @@ bool less(const Vec3& a, const Vec3& b) {
   return a.z < b.z;
 }
 
+// Hashes what Vec3's == compares: the numbers, so -0 and 0 (equal, different bits; STL
+// exporters write either) hash alike.
 struct VertexHash {
+  static std::uint64_t bits(double c) { return std::bit_cast<std::uint64_t>(c + 0.0); }  // -0 + 0 is +0
   std::size_t operator()(const Vec3& v) const {
-    std::uint64_t h = std::bit_cast<std::uint64_t>(v.x) * 0x9E3779B97F4A7C15ull;
-    h ^= std::bit_cast<std::uint64_t>(v.y) + 0x7F4A7C159E3779B9ull + (h << 6) + (h >> 2);
-    h ^= std::bit_cast<std::uint64_t>(v.z) + 0x94D049BB133111EBull + (h << 6) + (h >> 2);
+    std::uint64_t h = bits(v.x) * 0x9E3779B97F4A7C15ull;
+    h ^= bits(v.y) + 0x7F4A7C159E3779B9ull + (h << 6) + (h >> 2);
+    h ^= bits(v.z) + 0x94D049BB133111EBull + (h << 6) + (h >> 2);
     return std::size_t(h);
   }
 };

@@ -179,5 +179,24 @@ TEST(MeshCheck, AnOpenMeshIsReportedWithItsBoundaryEdgeCount) {
   }
 }
 
+TEST(MeshCheck, MinusZeroIsTheSameVertexAsZero) {
+  // Found by fuzz/stl_fuzz (fuzz/corpus/stl/regression-minus-zero.stl): exporters write -0
+  // for 0 now and then; welding hashed the bits of the coordinates, so -0 and 0 (equal as
+  // numbers) were two vertices and a closed mesh counted as open.
+  TriangleMesh signed_zeros = box_mesh({0, 0, 0}, {10, 10, 10});
+  for (std::size_t i = 0; i < signed_zeros.triangles.size(); i += 2)
+    for (Vec3& v : signed_zeros.triangles[i])
+      for (double* c : {&v.x, &v.y, &v.z})
+        if (*c == 0) *c = -0.0;
+  for (const TriangleMesh& mesh : {signed_zeros, parse_stl(binary_stl(signed_zeros), "zeros.stl"),
+                                   parse_stl(ascii_stl(signed_zeros), "zeros.stl")}) {
+    MeshReport report;
+    clean_mesh(mesh, &report);
+    EXPECT_TRUE(report.closed()) << report.boundary_edges << " boundary edges";
+    EXPECT_EQ(report.nonmanifold_edges, 0u);
+    EXPECT_NO_THROW(require_closed(report, "zeros.stl"));
+  }
+}
+
 }  // namespace
 }  // namespace hybridctl::geometry
