@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "../sanitizer_report.hpp"
 #include "shell.hpp"
 
 #include <chrono>
@@ -46,8 +47,11 @@ struct Background {
   void wait_exit(double seconds) const {
     for (int i = 0; i < int(seconds * 20) && alive(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
+  // SIGTERM, and its end awaited so that what it writes at exit (its report, a sanitizer's)
+  // is there before the test's directory is read and removed.
   ~Background() {
     if (alive()) ::kill(pid, SIGTERM);
+    wait_exit(15);
   }
 };
 
@@ -59,7 +63,17 @@ class Run : public ::testing::Test {
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
-  void TearDown() override { fs::remove_all(dir_); }
+  // The processes' stderr (*.err; dry-run's sim.log) carries no sanitizer report (the
+  // sanitizer build): a simulator started with `&` is not our child, so its exit status is
+  // not ours to check.
+  void TearDown() override {
+    for (const auto& entry : fs::recursive_directory_iterator(dir_)) {
+      if (entry.path().extension() != ".err" && entry.path().extension() != ".log") continue;
+      const std::string report = hybridctl::test::sanitizer_report(slurp(entry.path()));
+      EXPECT_TRUE(report.empty()) << "sanitizer report in " << entry.path().filename().string() << ":\n" << report;
+    }
+    fs::remove_all(dir_);
+  }
 
   // The bracket planned once at 0.5 mm into DIR/plan (shared by the tests of one process).
   static fs::path plan() {

@@ -2,6 +2,7 @@
 // What the CLI tests share: running hybridctl (or any command) through the shell and
 // reading back what it wrote.
 
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 
 #include <cstdlib>
@@ -9,6 +10,8 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include "../sanitizer_report.hpp"
 
 namespace hybridctl::cli_testing {
 
@@ -31,7 +34,8 @@ inline std::string quote(const std::string& s) {
   return q + "'";
 }
 
-// Runs `command` with its output in DIR/stdout and DIR/stderr and stdin from /dev/null.
+// Runs `command` with its output in DIR/stdout and DIR/stderr and stdin from /dev/null; a
+// sanitizer report on its stderr is a test failure.
 inline Outcome run_shell(const std::string& command, const std::filesystem::path& dir) {
   const std::string cmd = command + " >" + quote((dir / "stdout").string()) + " 2>" + quote((dir / "stderr").string()) +
                           " </dev/null";
@@ -40,6 +44,9 @@ inline Outcome run_shell(const std::string& command, const std::filesystem::path
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   r.out = slurp(dir / "stdout");
   r.err = slurp(dir / "stderr");
+  // In the sanitizer build a report fails the test even where a failure is the expected outcome.
+  const std::string report = hybridctl::test::sanitizer_report(r.err);
+  if (!report.empty()) ADD_FAILURE() << "sanitizer report from " << command << ":\n" << report;
   return r;
 }
 

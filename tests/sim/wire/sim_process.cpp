@@ -18,6 +18,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "../../sanitizer_report.hpp"
+
 extern char** environ;
 
 namespace hybridctl::test {
@@ -101,6 +103,13 @@ int terminate(pid_t pid, std::chrono::milliseconds grace) {
   return code;
 }
 
+// A sanitizer report in a child's output fails the test (the sanitizer build): the
+// processes ended by SIGTERM at a test's end would otherwise go unread.
+void expect_no_sanitizer_report(const std::string& what, const std::string& output) {
+  const std::string report = sanitizer_report(output);
+  if (!report.empty()) ADD_FAILURE() << "sanitizer report from " << what << ":\n" << report;
+}
+
 }  // namespace
 
 std::string example_machine() { return std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/hybrid-3axis.yaml"; }
@@ -152,6 +161,7 @@ PeerResult run_peer(const std::vector<std::string>& argv, std::chrono::milliseco
   ::waitpid(s.pid, &status, 0);
   ::close(s.out_fd);
   result.exit_code = decode_status(status);
+  expect_no_sanitizer_report(argv[0], result.output);
   return result;
 }
 
@@ -183,6 +193,11 @@ int BackgroundProcess::stop() {
   if (pid_ <= 0) return -1;
   const int code = terminate(pid_, 5000ms);
   pid_ = -1;
+  for (std::size_t before = output_.size() + 1; output_.size() != before;) {
+    before = output_.size();
+    read_available(0ms);
+  }
+  expect_no_sanitizer_report("a background process", output_);
   return code;
 }
 
@@ -251,6 +266,7 @@ int SimProcess::stop() {
     read_stdout(0ms);
     if (stdout_.size() == before) break;
   }
+  expect_no_sanitizer_report("hybridctl sim serve", errors());
   return code;
 }
 
@@ -262,6 +278,7 @@ int SimProcess::wait(std::chrono::milliseconds timeout) {
     if (::waitpid(pid_, &status, WNOHANG) == pid_) {
       pid_ = -1;
       read_stdout(0ms);
+      expect_no_sanitizer_report("hybridctl sim serve", errors());
       return decode_status(status);
     }
     if (Clock::now() >= end) return -1;
