@@ -27,6 +27,11 @@ const std::string kMachine = (kSource / "examples/machines/hybrid-3axis.yaml").s
 using hybridctl::cli_testing::quote;
 using hybridctl::cli_testing::slurp;
 
+// How long a background process may take to say it is up (sim serve loads the plan's stock
+// first; several times slower in the sanitizer build), in 50 ms polls: 20 s, as
+// tests/sim/wire/sim_process.hpp waits for sim serve's ready line.
+constexpr int kStartupPolls = 400;
+
 std::string command(const std::vector<std::string>& args) {
   std::string cmd = quote(HYBRIDCTL_EXE);
   for (const auto& a : args) cmd += " " + quote(a);
@@ -98,7 +103,7 @@ class Run : public ::testing::Test {
     args.insert(args.end(), extra.begin(), extra.end());
     auto sim = std::make_unique<Background>(command(args), dir_, "sim");
     port = 0;
-    for (int i = 0; i < 100 && !port; ++i) {
+    for (int i = 0; i < kStartupPolls && !port; ++i) {
       std::smatch m;
       const std::string out = slurp(dir_ / "sim.out");
       if (std::regex_search(out, m, std::regex("listening " + what + " 127\\.0\\.0\\.1:([0-9]+)"))) port = std::stoi(m[1]);
@@ -185,7 +190,10 @@ TEST_F(Run, AHostKilledMidProgramResumesFromItsJournal) {
     Background host(command({"run", plan().string(), "--machine", kMachine, "--transport",
                              "modbus-tcp://127.0.0.1:" + std::to_string(port), "--job", (dir_ / "job").string(), "--yes"}),
                     dir_, "host");
-    std::this_thread::sleep_for(std::chrono::milliseconds(1200));
+    // Once it streams (its status line says RUNNING; its journal exists), a little more, then kill it.
+    for (int i = 0; i < kStartupPolls && slurp(dir_ / "host.err").find("RUNNING") == std::string::npos; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
     ASSERT_TRUE(host.alive()) << "the host finished before it could be killed";
     ::kill(host.pid, SIGKILL);
     host.wait_exit(2);
@@ -202,8 +210,8 @@ TEST_F(Run, CtrlCHoldsTheFeedAndWithoutAnOperatorAborts) {
                            "modbus-tcp://127.0.0.1:" + std::to_string(port), "--job", (dir_ / "job").string(), "--yes"}),
                   dir_, "host");
   // Once it streams (its status line says RUNNING), Ctrl-C.
-  for (int i = 0; i < 200 && slurp(dir_ / "host.err").find("RUNNING") == std::string::npos; ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(25));
+  for (int i = 0; i < kStartupPolls && slurp(dir_ / "host.err").find("RUNNING") == std::string::npos; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
   ASSERT_TRUE(host.alive());
   ::kill(host.pid, SIGINT);
   host.wait_exit(10);
@@ -232,7 +240,7 @@ TEST_F(Run, ASetupChangeStopsForTheOperatorAndGoesOnWhenAcknowledged) {
                                    "tcp://127.0.0.1:0", "--time-scale", "0"};
   Background sim(command(args), dir_, "sim");
   int port = 0;
-  for (int i = 0; i < 100 && !port; ++i) {
+  for (int i = 0; i < kStartupPolls && !port; ++i) {
     std::smatch m;
     const std::string out = slurp(dir_ / "sim.out");
     if (std::regex_search(out, m, std::regex("listening modbus-tcp 127\\.0\\.0\\.1:([0-9]+)"))) port = std::stoi(m[1]);
@@ -273,7 +281,7 @@ TEST_F(Run, ModbusRtuOverASocatPtyPair) {
   ASSERT_EQ(std::system("command -v socat >/dev/null"), 0) << "socat is missing: run scripts/setup";
   Background socat("socat -d -d pty,raw,echo=0 pty,raw,echo=0", dir_, "socat");
   std::vector<std::string> ptys;
-  for (int i = 0; i < 100 && ptys.size() < 2; ++i) {
+  for (int i = 0; i < kStartupPolls && ptys.size() < 2; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
     ptys.clear();
     const std::string err = slurp(dir_ / "socat.err");
@@ -285,7 +293,7 @@ TEST_F(Run, ModbusRtuOverASocatPtyPair) {
                                    "--line-log", (dir_ / "lines.ngc").string(), "--modbus-rtu", ptys[0], "--baud", "115200",
                                    "--parity", "N", "--time-scale", "0"};
   Background sim(command(args), dir_, "sim");
-  for (int i = 0; i < 100 && slurp(dir_ / "sim.out").find("ready") == std::string::npos; ++i)
+  for (int i = 0; i < kStartupPolls && slurp(dir_ / "sim.out").find("ready") == std::string::npos; ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   EXPECT_EQ(run({"run", plan().string(), "--machine", kMachine, "--transport",
                  "modbus-rtu://" + ptys[1] + "?baud=115200&parity=N&unit=1", "--job", (dir_ / "job").string(), "--yes"}),
