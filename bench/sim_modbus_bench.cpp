@@ -20,78 +20,24 @@
 #include <arpa/inet.h>
 #include <modbus/modbus.h>
 #include <netinet/in.h>
-#include <poll.h>
-#include <sched.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "bench/bench_process.hpp"
 #include "drivers/protocol/chunk.hpp"
 #include "drivers/protocol/messages.hpp"
 #include "drivers/protocol/modbus_map.hpp"
-
-extern char** environ;
 
 namespace {
 
 namespace mb = hybridctl::protocol::modbus;
 using namespace hybridctl::protocol;
 
-constexpr int kCpu = 0;
-
-void pin(pid_t pid) {
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  CPU_SET(kCpu, &set);
-  if (sched_setaffinity(pid, sizeof set, &set) != 0) std::perror("sched_setaffinity");
-}
-
-struct Child {
-  pid_t pid = -1;
-  int port = 0;
-  ~Child() {
-    if (pid > 0) {
-      ::kill(pid, SIGTERM);
-      ::waitpid(pid, nullptr, 0);
-    }
-  }
-};
-
-// `hybridctl sim serve` on a free port, pinned; waits for its "ready" line.
-void start_simulator(Child& child) {
-  int fds[2];
-  if (::pipe(fds) != 0) throw std::runtime_error("pipe");
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_adddup2(&actions, fds[1], 1);
-  posix_spawn_file_actions_addclose(&actions, fds[0]);
-  const std::string machine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/hybrid-3axis.yaml";
-  std::vector<std::string> args = {HYBRIDCTL_EXE, "sim",           "serve", "--machine",          machine,
-                                   "--modbus",    "tcp://127.0.0.1:0", "--time-scale", "0", "--heartbeat-timeout", "0"};
-  std::vector<char*> argv;
-  for (auto& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  if (posix_spawn(&child.pid, argv[0], &actions, nullptr, argv.data(), environ) != 0)
-    throw std::runtime_error("cannot start " + args[0]);
-  posix_spawn_file_actions_destroy(&actions);
-  ::close(fds[1]);
-  pin(child.pid);
-  std::string out;
-  char buffer[256];
-  while (out.find("ready\n") == std::string::npos) {
-    pollfd p{fds[0], POLLIN, 0};
-    if (::poll(&p, 1, 20000) <= 0) throw std::runtime_error("the simulator printed no 'ready' line");
-    const ssize_t n = ::read(fds[0], buffer, sizeof buffer);
-    if (n <= 0) throw std::runtime_error("the simulator exited: " + out);
-    out.append(buffer, static_cast<std::size_t>(n));
-  }
-  ::close(fds[0]);
-  const auto at = out.find("listening modbus-tcp 127.0.0.1:");
-  child.port = std::stoi(out.substr(at + std::strlen("listening modbus-tcp 127.0.0.1:")));
-}
+using hybridctl::bench::ChildProcess;
+using hybridctl::bench::pin_to_cpu;
 
 // A libmodbus server that only receives and replies (the baseline), pinned, in a child.
-void start_bare_server(Child& child) {
+void start_bare_server(ChildProcess& child) {
   modbus_t* ctx = modbus_new_tcp("127.0.0.1", 0);
   const int listen_fd = modbus_tcp_listen(ctx, 1);
   sockaddr_in addr{};
@@ -100,7 +46,7 @@ void start_bare_server(Child& child) {
   child.port = ntohs(addr.sin_port);
   child.pid = ::fork();
   if (child.pid == 0) {
-    pin(0);
+    pin_to_cpu(0);
     modbus_mapping_t* map = modbus_mapping_new_start_address(0, 0, 0, 0, 0, mb::kHoldingRegisterCount, 0, mb::kInputRegisterCount);
     for (;;) {
       int fd = listen_fd;
@@ -137,9 +83,8 @@ std::vector<std::string> program(int moves) {
 double g_sim_rate = 0, g_bare_rate = 0;
 
 void BM_SimulatorChunksFc23(benchmark::State& state) {
-  Child sim;
-  start_simulator(sim);
-  pin(0);
+  ChildProcess sim = hybridctl::bench::start_simulator({"--modbus", "tcp://127.0.0.1:0"}, "modbus-tcp");
+  pin_to_cpu(0);
   modbus_t* ctx = connect(sim.port);
   const std::vector<std::string> lines = program(400000);
   const std::uint64_t identity = program_identity(lines);
@@ -197,9 +142,9 @@ void BM_SimulatorChunksFc23(benchmark::State& state) {
 }
 
 void BM_BareLibmodbusFc23(benchmark::State& state) {
-  Child bare;
+  ChildProcess bare;
   start_bare_server(bare);
-  pin(0);
+  pin_to_cpu(0);
   modbus_t* ctx = connect(bare.port);
   const std::vector<std::uint16_t> regs(mb::kMailboxRegisters, 0x4731);
   std::uint16_t status[mb::kStatusCount];
@@ -244,7 +189,7 @@ int main(int argc, char** argv) {
   RateReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
   if (g_sim_rate > 0 && g_bare_rate > 0) {
-    std::printf("\nsimulator / bare libmodbus FC23 (both pinned to CPU %d): %.0f / %.0f requests/s = %.2f\n", kCpu,
+    std::printf("\nsimulator / bare libmodbus FC23 (both pinned to CPU %d): %.0f / %.0f requests/s = %.2f\n", hybridctl::bench::kBenchCpu,
                 g_sim_rate, g_bare_rate, g_sim_rate / g_bare_rate);
   }
   benchmark::Shutdown();

@@ -12,10 +12,6 @@
 #include <benchmark/benchmark.h>
 
 #include <modbus/modbus.h>
-#include <poll.h>
-#include <sched.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -27,12 +23,11 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_process.hpp"
 #include "drivers/protocol/chunk.hpp"
 #include "drivers/protocol/messages.hpp"
 #include "drivers/protocol/modbus_map.hpp"
 #include "drivers/transport.hpp"
-
-extern char** environ;
 
 namespace {
 
@@ -40,62 +35,8 @@ namespace mb = hybridctl::protocol::modbus;
 using namespace hybridctl;
 using namespace hybridctl::protocol;
 
-constexpr int kCpu = 0;
-
-void pin(pid_t pid) {
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  CPU_SET(kCpu, &set);
-  if (sched_setaffinity(pid, sizeof set, &set) != 0) std::perror("sched_setaffinity");
-}
-
-// `hybridctl sim serve` on a free port, pinned, for the whole run.
-struct Simulator {
-  pid_t pid = -1;
-  int port = 0;
-
-  Simulator() {
-    int fds[2];
-    if (::pipe(fds) != 0) throw std::runtime_error("pipe");
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_adddup2(&actions, fds[1], 1);
-    posix_spawn_file_actions_addclose(&actions, fds[0]);
-    const std::string machine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/hybrid-3axis.yaml";
-    std::vector<std::string> args = {HYBRIDCTL_EXE, "sim",          "serve", "--machine",           machine,
-                                     "--modbus",    "tcp://127.0.0.1:0", "--time-scale", "0", "--heartbeat-timeout",
-                                     "0"};
-    std::vector<char*> argv;
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    if (posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ) != 0)
-      throw std::runtime_error("cannot start " + args[0]);
-    posix_spawn_file_actions_destroy(&actions);
-    ::close(fds[1]);
-    pin(pid);
-    std::string out;
-    char buffer[256];
-    while (out.find("ready\n") == std::string::npos) {
-      pollfd p{fds[0], POLLIN, 0};
-      if (::poll(&p, 1, 20000) <= 0) throw std::runtime_error("the simulator printed no 'ready' line");
-      const ssize_t n = ::read(fds[0], buffer, sizeof buffer);
-      if (n <= 0) throw std::runtime_error("the simulator exited: " + out);
-      out.append(buffer, static_cast<std::size_t>(n));
-    }
-    ::close(fds[0]);
-    const std::string key = "listening modbus-tcp 127.0.0.1:";
-    port = std::stoi(out.substr(out.find(key) + key.size()));
-  }
-  ~Simulator() {
-    if (pid > 0) {
-      ::kill(pid, SIGTERM);
-      ::waitpid(pid, nullptr, 0);
-    }
-  }
-};
-
-Simulator& simulator() {
-  static Simulator sim;
+const bench::ChildProcess& simulator() {
+  static const bench::ChildProcess sim = bench::start_simulator({"--modbus", "tcp://127.0.0.1:0"}, "modbus-tcp");
   return sim;
 }
 
@@ -183,7 +124,7 @@ void chunk_loop(benchmark::State& state, Send&& send, Command&& command) {
 }
 
 void BM_TransportSendChunk(benchmark::State& state) {
-  pin(0);
+  bench::pin_to_cpu(0);
   auto t = drivers::open_transport("modbus-tcp://127.0.0.1:" + std::to_string(simulator().port));
   const std::uint64_t identity = program_identity(lines());
   chunk_loop(
@@ -197,7 +138,7 @@ void BM_TransportSendChunk(benchmark::State& state) {
 }
 
 void BM_BareLibmodbusFc23(benchmark::State& state) {
-  pin(0);
+  bench::pin_to_cpu(0);
   modbus_t* ctx = modbus_new_tcp("127.0.0.1", simulator().port);
   modbus_set_response_timeout(ctx, 2, 0);
   if (modbus_connect(ctx) != 0) {
@@ -259,7 +200,7 @@ int main(int argc, char** argv) {
   RateReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
   if (g_transport.requests > 0 && g_bare.requests > 0) {
-    std::printf("\nModbusTransport::send_chunk / bare libmodbus FC23, same simulator, both pinned to CPU %d:\n", kCpu);
+    std::printf("\nModbusTransport::send_chunk / bare libmodbus FC23, same simulator, both pinned to CPU %d:\n", hybridctl::bench::kBenchCpu);
     std::printf("  %.0f / %.0f requests/s = %.2f\n", g_transport.requests, g_bare.requests,
                 g_transport.requests / g_bare.requests);
     std::printf("  %.0f / %.0f lines/s (~28-byte lines, chunks up to 222 bytes)\n", g_transport.lines, g_bare.lines);

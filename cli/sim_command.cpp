@@ -56,8 +56,8 @@ struct ServeRequest {
   std::string socketcan;   // interface
   int node = 1;
   std::uint32_t can_bitrate = 0;
-  int status_period_ms = 50;
-  int can_block_size = 8;
+  int status_period_ms = 100;
+  int can_block_size = 0;
   double time_scale = 1.0;
   std::uint32_t buffer_bytes = 16384;
   double heartbeat_timeout_s = 2.0;

@@ -122,7 +122,10 @@ std::optional<protocol::Status> CanTransport::wait_status(SteadyTime deadline, s
     auto frame = io_->receive(deadline);
     if (!frame) return std::nullopt;
     dispatch(*frame);
-    if (generation_ != before && generation_ > after_generation && latest_ && fits(*latest_)) return latest_;
+    if (generation_ != before && generation_ > after_generation && latest_ && fits(*latest_)) {
+      returned_generation_ = generation_;
+      return latest_;
+    }
   }
 }
 
@@ -167,6 +170,12 @@ protocol::Status CanTransport::read_status() {
   }() + ")",
              [&]() -> std::variant<protocol::Status, Issue> {
                drain();
+               // A snapshot that arrived since the last one returned is news: no need to
+               // wait up to a status period for the next (the end of a program, an alarm).
+               if (latest_ && generation_ > returned_generation_) {
+                 returned_generation_ = generation_;
+                 return *latest_;
+               }
                const auto deadline = SteadyClock::now() + options_.response_timeout;
                if (auto s = wait_status(deadline, generation_, [](const protocol::Status&) { return true; })) return *s;
                return Issue{Kind::Timeout, "no status snapshot within " +

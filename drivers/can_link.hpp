@@ -3,8 +3,9 @@
 // part shared by the kernel SocketCAN and the socketcand backends. A CanFrameIo moves
 // frames; CanTransport speaks the protocol over it:
 //
-//   read_status     the next status snapshot (0x180 + N, 16 frames) that completes after
-//                   the call began (the controller sends one at least every 100 ms)
+//   read_status     the newest status snapshot (0x180 + N, 16 frames) that arrived since
+//                   the last one a call returned; if none, the next one to complete (the
+//                   controller sends one at least every 100 ms and on every state change)
 //   send_command    the command frames (0x100 + N), then the first snapshot whose
 //                   command_seq is the command's seq
 //   send_chunk      the chunk message segmented on 0x200 + N by protocol::can::CanSegmenter,
@@ -94,6 +95,7 @@ class CanTransport final : public Transport {
   bool in_snapshot_ = false;
   std::optional<protocol::Status> latest_;
   std::uint64_t generation_ = 0;  // snapshots completed so far
+  std::uint64_t returned_generation_ = 0;  // the newest snapshot a call has returned
   protocol::can::CanSegmenter* segmenter_ = nullptr;  // the transfer in progress, for flow control
   bool ever_open_ = false;
   TransportCounters counters_;

@@ -5,8 +5,11 @@
 
 #include <cerrno>
 #include <chrono>
+#include <condition_variable>
 #include <cstring>
 #include <fstream>
+#include <mutex>
+#include <thread>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -32,33 +35,80 @@ std::string hex64(std::uint64_t v) {
 
 }  // namespace
 
+// fdatasync on a thread of its own, on a duplicate of the journal's descriptor (the same
+// open file: it syncs what the journal wrote). A request while one is running makes one
+// more after it, so every line written before a request is on disk when a sync ends.
+struct Journal::BackgroundSync {
+  explicit BackgroundSync(int journal_fd) : fd(::fcntl(journal_fd, F_DUPFD_CLOEXEC, 0)) {
+    thread = std::thread([this] { run(); });
+  }
+  ~BackgroundSync() {
+    {
+      std::lock_guard lock(mutex);
+      stop = true;
+    }
+    wake.notify_one();
+    thread.join();
+    if (fd >= 0) ::close(fd);
+  }
+  void request() {
+    {
+      std::lock_guard lock(mutex);
+      pending = true;
+    }
+    wake.notify_one();
+  }
+  void run() {
+    std::unique_lock lock(mutex);
+    while (true) {
+      wake.wait(lock, [&] { return pending || stop; });
+      if (!pending) return;
+      pending = false;
+      lock.unlock();
+      if (fd >= 0) ::fdatasync(fd);
+      lock.lock();
+    }
+  }
+
+  int fd;
+  std::mutex mutex;
+  std::condition_variable wake;
+  bool pending = false, stop = false;
+  std::thread thread;
+};
+
 Journal::Journal(fs::path path, int fd, JournalHeader header, JournalProgress progress)
     : path_(std::move(path)), fd_(fd), last_sync_(seconds_now()), header_(std::move(header)), progress_(progress) {}
 
 Journal::Journal(Journal&& o) noexcept
     : sync_period_s(o.sync_period_s), path_(std::move(o.path_)), fd_(o.fd_), last_sync_(o.last_sync_),
-      header_(std::move(o.header_)), progress_(o.progress_) {
+      header_(std::move(o.header_)), progress_(o.progress_), background_(std::move(o.background_)) {
   o.fd_ = -1;
 }
 
 Journal& Journal::operator=(Journal&& o) noexcept {
   if (this != &o) {
-    if (fd_ >= 0) ::close(fd_);
+    close();
     sync_period_s = o.sync_period_s;
     path_ = std::move(o.path_);
     fd_ = o.fd_;
     last_sync_ = o.last_sync_;
     header_ = std::move(o.header_);
     progress_ = o.progress_;
+    background_ = std::move(o.background_);
     o.fd_ = -1;
   }
   return *this;
 }
 
-Journal::~Journal() {
+Journal::~Journal() { close(); }
+
+void Journal::close() {
+  background_.reset();  // waits for a sync in progress
   if (fd_ >= 0) {
     ::fsync(fd_);
     ::close(fd_);
+    fd_ = -1;
   }
 }
 
@@ -156,7 +206,13 @@ void Journal::acknowledged(std::uint32_t chunk, std::uint32_t through_line, std:
   progress_.through_line = through_line;
   progress_.executed_line = executed_line;
   const json j = {{"chunk", chunk}, {"through_line", through_line}, {"executed_line", executed_line}};
-  append(j.dump(), seconds_now() - last_sync_ >= sync_period_s);
+  append(j.dump(), false);
+  const double now = seconds_now();
+  if (now - last_sync_ >= sync_period_s) {
+    if (!background_) background_ = std::make_unique<BackgroundSync>(fd_);
+    background_->request();
+    last_sync_ = now;
+  }
 }
 
 void Journal::note(const std::string& event) { append(json{{"note", event}}.dump(), false); }

@@ -2,12 +2,15 @@
 // The job journal: an append-only file that lets `hybridctl run --resume JOB` continue a
 // program after the host process died. One JSON object per line: a header (the program
 // file, its identity and line count, machine file, transport), then the acknowledged
-// progress (chunk, through which line), fsync'd whenever an acknowledged range is
-// recorded, so what the journal says happened did happen. The controller's own status
-// stays the truth for where to continue; the journal says what to continue.
+// progress (chunk, through which line), written as each range is acknowledged and synced
+// to disk at most sync_period_s later by a background thread (the stream does not wait
+// for the disk: an fsync takes milliseconds, a CAN bus idles meanwhile), the end of the
+// job at once. The controller's own status stays the truth for where to continue; the
+// journal says what to continue.
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -46,8 +49,9 @@ class Journal {
   const JournalProgress& progress() const { return progress_; }
   std::filesystem::path file() const { return path_; }
 
-  // Records an acknowledged chunk. Ranges are fsync'd at most every `sync_period_s`
-  // (and always at the end): the controller, not the journal, says where to go on.
+  // Records an acknowledged chunk. The file is synced in the background within
+  // `sync_period_s` (and at once at the end): the controller, not the journal, says
+  // where to go on.
   void acknowledged(std::uint32_t chunk, std::uint32_t through_line, std::uint32_t executed_line);
   double sync_period_s = 0.1;
   // Free-form events (reconnects, reboots, alarms), not fsync'd on their own.
@@ -55,14 +59,17 @@ class Journal {
   void completed(std::uint32_t executed_line);
 
  private:
+  struct BackgroundSync;
   Journal(std::filesystem::path path, int fd, JournalHeader header, JournalProgress progress);
   void append(const std::string& line, bool sync);
+  void close();
 
   std::filesystem::path path_;
   int fd_ = -1;
   double last_sync_ = 0;
   JournalHeader header_;
   JournalProgress progress_;
+  std::unique_ptr<BackgroundSync> background_;  // made at the first acknowledged range
 };
 
 }  // namespace hybridctl::drivers

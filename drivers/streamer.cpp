@@ -116,9 +116,12 @@ class Session {
   }
 
   // Sends chunks while the controller has room; the status after each says what next.
+  // At most kChunksPerRound, so heartbeats and hold requests are seen between rounds.
+  static constexpr int kChunksPerRound = 64;
   void fill() {
     const std::size_t max = t_.max_chunk_payload();
-    for (int sent = 0; sent < 64; ++sent) {
+    more_to_send_ = false;
+    for (int sent = 0; sent < kChunksPerRound; ++sent) {
       if (status_.identity != identity_ || !protocol::accepts_chunks(status_.state)) return;
       const std::uint32_t line = status_.next_line;
       if (line == 0 || line > lines_.size()) return;
@@ -140,6 +143,7 @@ class Session {
       if (r == ResultCode::Accepted) {
         ++result_.counters.chunks_accepted;
         if (journal_) journal_->acknowledged(c.seq, c.first_line + c.line_count - 1, status_.last_executed_line);
+        more_to_send_ = sent + 1 == kChunksPerRound;
       } else if (r == ResultCode::Duplicate) {
         ++result_.counters.duplicates;
       } else if (r == ResultCode::BufferFull) {
@@ -238,6 +242,9 @@ class Session {
         }
         break;
     }
+    // The round ended at its cap with chunks still going in: the status after the last one
+    // is fresh, go on sending (a status read could wait a whole CAN status period).
+    if (more_to_send_) return false;
     // Nothing to do but wait: read the status again.
     const bool room = status_.next_line <= lines_.size() && status_.free_buffer_bytes >= t_.max_chunk_payload();
     if (!room) std::this_thread::sleep_for(std::chrono::duration<double>(options_.poll_period_s));
@@ -255,6 +262,7 @@ class Session {
   std::uint16_t boot_ = 0, seq_ = 0, heartbeat_ = 0;
   Clock::time_point last_heartbeat_;
   bool started_ = false, held_by_us_ = false, host_hold_ = false;
+  bool more_to_send_ = false;  // fill() stopped at its cap, not for want of room
   std::uint32_t refused_seq_ = 0;
   ResultCode refused_result_ = ResultCode::None;
   int refusals_ = 0;

@@ -7,4 +7,4 @@ add_library(hybridctl_streaming STATIC
 target_include_directories(hybridctl_streaming PUBLIC ${PROJECT_SOURCE_DIR})
 target_link_libraries(hybridctl_streaming
   PUBLIC hybridctl_protocol hybridctl_common
-  PRIVATE hybridctl_warnings nlohmann_json::nlohmann_json)
+  PRIVATE hybridctl_warnings nlohmann_json::nlohmann_json Threads::Threads)

@@ -37,7 +37,11 @@ void CanNode::send(const can::CanFrame& frame) {
 }
 
 void CanNode::send_status(CanMicros now) {
-  for (const can::CanFrame& f : can::encode_status_frames(controller_.status(), snapshot_, options_.node)) send(f);
+  const protocol::Status status = controller_.status();
+  reported_state_ = status.state;
+  reported_alarm_ = status.alarm;
+  reported_full_ = status.free_buffer_bytes < status.max_chunk_payload;
+  for (const can::CanFrame& f : can::encode_status_frames(status, snapshot_, options_.node)) send(f);
   ++snapshot_;
   ++counters_.status_snapshots;
   next_status_ = now + std::chrono::duration_cast<CanMicros>(options_.status_period);
@@ -120,7 +124,15 @@ void CanNode::tick(CanMicros now) {
     ++counters_.transfer_errors;
     last_error_ = r.error->message;
   }
-  if (now >= next_status_) send_status(now);
+  // A state change (RUNNING -> COMPLETED, an alarm), or room for a chunk in a buffer the
+  // host last saw full, goes out at once rather than at the next periodic snapshot: the
+  // host is waiting for it, and it costs one snapshot per change.
+  if (now >= next_status_ || controller_.state() != reported_state_ || controller_.alarm() != reported_alarm_) {
+    send_status(now);
+  } else if (reported_full_) {
+    const protocol::Status s = controller_.status();
+    if (s.free_buffer_bytes >= s.max_chunk_payload) send_status(now);
+  }
 }
 
 CanMicros CanNode::next_deadline() const { return next_status_; }

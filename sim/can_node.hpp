@@ -9,8 +9,11 @@
 //                  0x200+N chunk segments   CanReassembler (answers flow control on 0x280+N)
 //                                           -> controller.write_message
 //                  0x700+N heartbeat        -> controller.write_heartbeat
-//   node -> host   0x180+N status snapshot  16 frames, every status_period and right after
-//                                           every command or chunk the controller took
+//   node -> host   0x180+N status snapshot  16 frames, right after every command or chunk
+//                                           the controller took, when its state or alarm
+//                                           changes, when its buffer has room for a whole
+//                                           chunk again after the last snapshot said it had
+//                                           not, and at least every status_period
 //                  0x280+N flow control
 // Frames with other identifiers (other nodes, other traffic) are ignored and counted.
 
@@ -31,7 +34,7 @@ using CanMicros = protocol::can::Micros;
 
 struct CanNodeOptions {
   std::uint8_t node = 1;                                   ///< 1..127
-  std::chrono::milliseconds status_period{50};             ///< a status snapshot at least this often
+  std::chrono::milliseconds status_period{100};            ///< a status snapshot at least this often
   protocol::can::ReassemblerSettings reassembler{};        ///< flow control block size, STmin, timeouts
 };
 
@@ -59,7 +62,9 @@ class CanNode {
   /// taking it (fault injection: the CAN counterpart of "server busy"). False when the
   /// frame is not a first frame on this node's data identifier (then nothing happened).
   bool refuse_transfer(const protocol::can::CanFrame& first_frame);
-  /// Timed work: transfer timeouts and status snapshots when due.
+  /// Timed work: transfer timeouts, status snapshots when due, and a snapshot when the
+  /// controller's state or alarm changed since the last one, or its buffer has room for a
+  /// chunk again (call after it advanced).
   void tick(CanMicros now);
   /// When tick() next has work.
   CanMicros next_deadline() const;
@@ -83,6 +88,11 @@ class CanNode {
   std::deque<protocol::can::CanFrame> outbox_;
   CanMicros next_status_{0};
   std::uint8_t snapshot_ = 0;
+  // What the last snapshot reported: state, alarm, and whether the buffer had room for a
+  // chunk of the largest size (a host with more to send waits for that room).
+  protocol::ControllerState reported_state_{};
+  protocol::AlarmCode reported_alarm_{};
+  bool reported_full_ = false;
   CanNodeCounters counters_;
   std::string last_error_;
 };

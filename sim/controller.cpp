@@ -315,6 +315,9 @@ protocol::Status Controller::status() const {
   return s;
 }
 
+protocol::ControllerState Controller::state() const { return impl_->state; }
+protocol::AlarmCode Controller::alarm() const { return impl_->alarm; }
+
 void Controller::advance(double real_seconds) { impl_->advance(real_seconds); }
 
 void Controller::reboot() {

@@ -88,6 +88,10 @@ class Controller {
   protocol::ResultCode write_command(const protocol::Command& command);
   void write_heartbeat(std::uint16_t counter);
   protocol::Status status() const;
+  // The state and alarm of status(), without building the whole block (the CAN node
+  // checks them after every step to send a snapshot when they change).
+  protocol::ControllerState state() const;
+  protocol::AlarmCode alarm() const;
 
   // --- time: runs the program for `real_seconds` of wall time (scaled by time_scale),
   // or, at time scale 0, executes whatever is queued (bounded per call).

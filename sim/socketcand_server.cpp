@@ -345,7 +345,9 @@ struct SocketcandServer::Impl {
     }
   }
 
-  // Moves frames along the bus up to `now`.
+  // Moves frames along the bus up to `now`. The node takes each frame, and answers it, at
+  // the moment the frame ends on the modelled bus (its due time), however late this loop
+  // got to it: the simulator's own scheduling delays do not idle the bus.
   void pump(SteadyTime now) {
     const CanMicros t = to_micros(now);
     while (!to_node.empty() && to_node.front().due <= t) {
@@ -354,21 +356,27 @@ struct SocketcandServer::Impl {
       if (first_frame(f.frame, node.node()) && faults.refuse_request()) {
         node.refuse_transfer(f.frame);
       } else {
-        node.on_frame(f.frame, t);
+        node.on_frame(f.frame, f.due);
       }
+      put_node_frames_on_bus(f.due);
     }
     node.tick(t);
+    put_node_frames_on_bus(t);
+    while (!to_hosts.empty() && to_hosts.front().due <= t) {
+      deliver(to_hosts.front(), now);
+      to_hosts.pop_front();
+    }
+  }
+
+  // The node's outbox onto the bus, from `at` on (each frame after the one before).
+  void put_node_frames_on_bus(CanMicros at) {
     auto& outbox = node.outbox();
     while (!outbox.empty()) {
       const can::CanFrame frame = outbox.front();
       outbox.pop_front();
-      CanMicros due = bus.reserve(t, frame.len);
+      CanMicros due = bus.reserve(at, frame.len);
       if (faults.delays()) due += std::chrono::duration_cast<CanMicros>(faults.reply_delay());
       insert_to_hosts({due, frame, -1});
-    }
-    while (!to_hosts.empty() && to_hosts.front().due <= t) {
-      deliver(to_hosts.front(), now);
-      to_hosts.pop_front();
     }
   }
 

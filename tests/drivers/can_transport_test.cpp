@@ -96,7 +96,8 @@ TEST(SocketcandTransport, AnotherNodeIsSilent) {
 
 TEST(SocketcandTransport, StreamsWholeChunksPacedByFlowControl) {
   const std::string dir = scratch_dir("socketcand-stream");
-  SimProcess sim(sim_args({}, dir + "/report.json"));
+  // A controller that grants 8 frames per flow control (the default grants a whole chunk).
+  SimProcess sim(sim_args({"--can-block-size", "8"}, dir + "/report.json"));
   auto t = drivers::open_transport(uri(sim), quick_options());
   StreamOutcome out;
   // 4075-byte chunks: 584 frames each, a flow control every 8.
