@@ -203,10 +203,12 @@ int run_job(const RunRequest& request) {
     std::printf("  %-60s %u/%u lines\n", actions[i].second.c_str(), done, last - first + 1);
   }
   std::printf("counters    chunks %llu sent, %llu accepted, %llu duplicates, %llu refused; %llu reboots seen, %llu alarms "
-              "cleared; transport %llu requests, %llu timeouts, %llu retries, %llu reconnects, %llu bad replies\n",
+              "cleared, %llu link failures recovered; transport %llu requests, %llu timeouts, %llu retries, %llu reconnects, "
+              "%llu bad replies\n",
               (unsigned long long)r.counters.chunks_sent, (unsigned long long)r.counters.chunks_accepted,
               (unsigned long long)r.counters.duplicates, (unsigned long long)r.counters.refused,
               (unsigned long long)r.counters.reboots_seen, (unsigned long long)r.counters.recoveries,
+              (unsigned long long)r.counters.transport_errors,
               (unsigned long long)tc.requests, (unsigned long long)tc.timeouts, (unsigned long long)tc.retries,
               (unsigned long long)tc.reconnects, (unsigned long long)tc.bad_replies);
   return r.completed ? int(kSuccess) : int(kMachineStopped);

@@ -440,7 +440,8 @@ int serve(const ServeRequest& r) {
           {"corrupt_every", faults.corrupt_every},
           {"exception_every", faults.exception_every},
           {"reboot_after_lines", faults.reboot_after_lines},
-          {"alarm_at_line", faults.alarm_at_line}}},
+          {"alarm_at_line", faults.alarm_at_line},
+          {"seed", faults.seed ? json(*faults.seed) : json(nullptr)}}},
         {"injected",
          {{"dropped", injected.dropped},
           {"delayed", injected.delayed},
@@ -539,6 +540,10 @@ void add_sim_command(CLI::App& app, Runner& runner) {
       ->group(faults);
   serve_cmd->add_option("--reboot-after-lines", r->reboot_after_lines,
                         "Reboot the controller once it executed L lines (repeatable, or L1,L2,...)")
+      ->group(faults);
+  serve_cmd->add_option("--fault-seed", r->faults.seed,
+                        "Random faults from this seed: each --*-every N strikes with probability 1/N, "
+                        "--delay-ms D holds each reply a random 0..D ms")
       ->group(faults);
   serve_cmd->add_option("--alarm-at-line", r->faults.alarm_at_line, "EMERGENCY_STOP when program line L is about to run")
       ->group(faults);

@@ -42,10 +42,36 @@ class Session {
     seq_ = status_.command_seq;
     open_program();
     last_heartbeat_ = Clock::now() - std::chrono::seconds(1);
+    int failures_in_row = 0;  // transport failures with no progress in between
+    std::uint64_t progress_at_failure = 0;
+    bool reread = false;
     while (true) {
-      heartbeat();
-      fill();
-      if (decide()) break;
+      try {
+        if (reread) {
+          seen(t_.read_status());
+          reread = false;
+        }
+        heartbeat();
+        fill();
+        if (decide()) break;
+      } catch (const TransportError& e) {
+        // The transport gave up on one request after its own resends, but the controller
+        // answered before: a bad spell on the line, not a lost controller. Pause, read
+        // the status again, and let it say what to send (a chunk that arrived comes back
+        // DUPLICATE). An unreachable controller, or one failing request after another,
+        // ends the stream: the journal lets `run --resume` go on later.
+        const bool transient = e.kind() != TransportError::Kind::Unreachable && e.kind() != TransportError::Kind::Unsupported;
+        // Progress: chunks taken or lines executed since the last failure.
+        const std::uint64_t progress = result_.counters.chunks_accepted + status_.last_executed_line;
+        failures_in_row = progress != progress_at_failure ? 1 : failures_in_row + 1;
+        progress_at_failure = progress;
+        if (!transient || failures_in_row > options_.max_failures_in_row) throw;
+        ++result_.counters.transport_errors;
+        note(std::string("the link failed (") + e.what() + "); reading the controller's status again");
+        const int doublings = std::min(failures_in_row - 1, 5);
+        std::this_thread::sleep_for(std::min(std::chrono::milliseconds(100 << doublings), std::chrono::milliseconds(2000)));
+        reread = true;
+      }
     }
     result_.final_status = status_;
     if (journal_ && result_.completed) journal_->completed(status_.last_executed_line);

@@ -45,6 +45,11 @@ struct StreamOptions {
   double poll_period_s = 0.002;     // status polling when there is nothing to send
   // Resume: the controller must hold this very program (its identity); never SET_PROGRAM.
   bool resume = false;
+  // A request the transport gave up on (after its own resends) costs a pause (100 ms,
+  // doubling up to 2 s) and a fresh status read; this many in a row with no progress in
+  // between (no chunk taken, no line executed) end the stream (TransportError).
+  // Unreachable ends it at once.
+  int max_failures_in_row = 5;
 };
 
 struct StreamCounters {
@@ -52,7 +57,7 @@ struct StreamCounters {
   std::uint64_t chunks_accepted = 0;
   std::uint64_t duplicates = 0;      // the controller already had it (a lost reply)
   std::uint64_t refused = 0;         // gap, line mismatch, buffer full ...: recomputed from the status
-  std::uint64_t transport_errors = 0;
+  std::uint64_t transport_errors = 0;  // requests the transport gave up on, recovered from here
   std::uint64_t reboots_seen = 0;
   std::uint64_t recoveries = 0;      // alarms cleared with RESET_ALARM + RESUME
 };

@@ -388,6 +388,10 @@ class PocketBuilder {
   // is in reach. Heights at or below it touch material.
   enum class Part { Whole, Cutter, Body };
   double contact_height(Cell c, Part part) const;
+  // Where a rapid coming down over `c` stops: material_allowance beside and above the
+  // material the whole tool would meet there, retract_clearance above that, and not below
+  // `at_least` + retract_clearance.
+  double rapid_stop(Cell c, double at_least) const;
   void refresh_tops(const IndexBox& xy);
 
   void move(MoveKind kind, Vec3 to, double feed, bool cutting, std::string comment = {});
@@ -451,6 +455,15 @@ double PocketBuilder::contact_height(Cell c, Part part) const {
     need = std::max(need, centre_z(top) - zmin);
   }
   return need;
+}
+
+double PocketBuilder::rapid_stop(Cell c, double at_least) const {
+  const int r = int(std::ceil(options_.material_allowance / h_ - 1e-9));
+  double top = contact_height(c, Part::Whole);
+  for (int dy = -r; dy <= r; ++dy)
+    for (int dx = -r; dx <= r; ++dx)
+      if (dx * dx + dy * dy <= r * r) top = std::max(top, contact_height({c.x + dx, c.y + dy}, Part::Whole));
+  return std::max(top + options_.material_allowance, at_least) + options_.retract_clearance;
 }
 
 void PocketBuilder::refresh_tops(const IndexBox& xy) {
@@ -613,7 +626,7 @@ bool PocketBuilder::enter(const CellPath& p, int k, const SliceMask& usable) {
   // 1. Air all the way down, at the start or on the line before it: plunge there (and
   // lead in).
   if (const std::optional<Cell> a = air_entry(p, k, usable)) {
-    go_above(*a, std::max(contact_height(*a, Part::Whole), zk) + options_.retract_clearance);
+    go_above(*a, rapid_stop(*a, zk));
     move(MoveKind::Feed, at_cell(*a, zk), tool_.plunge_feed, false, "plunge in air");
     at_level_ = true;
     for_leg_cells(*a, b, [&](Cell c) { run_cells_.push_back(c); });
@@ -654,7 +667,7 @@ bool PocketBuilder::enter(const CellPath& p, int k, const SliceMask& usable) {
     if (i == 0 && run >= wanted) break;
   }
   const double z_rs = ramp_start(best_dir, best_run);
-  go_above(b, z_rs + options_.retract_clearance);
+  go_above(b, rapid_stop(b, z_rs));
   move(MoveKind::Feed, at_cell(b, z_rs), tool_.plunge_feed, false, "down to the material (air)");
   at_level_ = true;
   run_cells_.push_back(b);

@@ -49,6 +49,10 @@ struct PocketOptions {
   double ramp_angle_deg = 3.0;
   // Rapids stop this far (mm) above the material the tool would meet at an entry.
   double retract_clearance = 1.0;
+  // Rapids keep this much (mm) further from the plan's material, sideways and above: the
+  // stock as built is not the plan's voxels (deposition beads spill up to ~0.7 mm past
+  // them, docs/toolpaths.md), and a rapid must not meet what a feed move would shave off.
+  double material_allowance = 1.0;
   // safe_z: this far (mm) above the highest material in the domain.
   double safe_clearance = 5.0;
   // Overrides of the tool's step_down and step_over (mm).

@@ -2,12 +2,16 @@
 // Fault injection for `hybridctl sim serve`: the wire servers (sim/modbus_server.hpp,
 // sim/socketcand_server.hpp) ask a FaultInjector before answering, so a host's retry,
 // reconnect and resume logic meets the faults a real line and controller produce, in a
-// reproducible order. Every kind counts its own stream of events (the k-th event of a
-// kind is hit when k is a multiple of its period), so the faults of one run are the same
-// every time; docs/simulator.md lists which events each transport counts.
+// reproducible order. Every kind counts its own stream of events: by default the k-th
+// event of a kind is hit when k is a multiple of its period; with a seed, each event is hit
+// with probability 1/period and delays are random, drawn from that seed (a soak run's
+// faults, still the same every time for the same seed and traffic). docs/simulator.md
+// lists which events each transport counts.
 
 #include <chrono>
 #include <cstdint>
+#include <optional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -20,6 +24,9 @@ struct FaultOptions {
   std::uint32_t exception_every = 0;  ///< every N-th request answered "busy" (Modbus exception 6) unprocessed; 0: never
   std::vector<std::uint32_t> reboot_after_lines;  ///< reboot the controller once it executed L lines (each L once)
   std::uint32_t alarm_at_line = 0;    ///< EMERGENCY_STOP when this program line is about to execute (the controller does it)
+  /// Random faults: each event of a kind with period N is hit with probability 1/N, each
+  /// reply held back a uniform 0..delay_ms ms, all drawn from this seed. Unset: periodic.
+  std::optional<std::uint64_t> seed;
 
   bool any() const {
     return drop_every || delay_ms || corrupt_every || exception_every || !reboot_after_lines.empty() || alarm_at_line;
@@ -37,7 +44,7 @@ struct FaultCounters {
 /// One transport's fault schedule. Not thread-safe (the serve loop is one thread).
 class FaultInjector {
  public:
-  explicit FaultInjector(const FaultOptions& options = {}) : options_(options) {}
+  explicit FaultInjector(const FaultOptions& options = {}) : options_(options), random_(options.seed.value_or(0)) {}
 
   /// A request arrived: true when this one is to be dropped (its connection closed).
   bool drop_request() { return hit(options_.drop_every, requests_for_drop_, counters_.dropped); }
@@ -47,8 +54,10 @@ class FaultInjector {
   bool corrupt_reply() { return hit(options_.corrupt_every, replies_, counters_.corrupted); }
   /// How long to hold a reply back (counts it when non-zero).
   std::chrono::milliseconds reply_delay() {
-    if (options_.delay_ms) ++counters_.delayed;
-    return std::chrono::milliseconds(options_.delay_ms);
+    std::uint32_t ms = options_.delay_ms;
+    if (ms && options_.seed) ms = static_cast<std::uint32_t>(random_() % (std::uint64_t{ms} + 1));
+    if (ms) ++counters_.delayed;
+    return std::chrono::milliseconds(ms);
   }
   bool delays() const { return options_.delay_ms != 0; }
   bool corrupts() const { return options_.corrupt_every != 0; }
@@ -57,14 +66,17 @@ class FaultInjector {
   const FaultOptions& options() const { return options_; }
 
  private:
-  static bool hit(std::uint32_t every, std::uint64_t& events, std::uint64_t& injected) {
+  bool hit(std::uint32_t every, std::uint64_t& events, std::uint64_t& injected) {
     if (every == 0) return false;
-    if (++events % every != 0) return false;
+    ++events;
+    const bool strikes = options_.seed ? random_() % every == 0 : events % every == 0;
+    if (!strikes) return false;
     ++injected;
     return true;
   }
 
   FaultOptions options_;
+  std::mt19937_64 random_;
   std::uint64_t requests_for_drop_ = 0;
   std::uint64_t requests_for_busy_ = 0;
   std::uint64_t replies_ = 0;

@@ -198,6 +198,7 @@ struct SocketcandServer::Impl {
   std::vector<Client> clients;
   std::deque<BusFrame> to_node;   // host frames on their way to the node, by due time
   std::deque<BusFrame> to_hosts;  // frames on their way to the raw-mode clients, by due time
+  CanMicros last_delayed_due{0};  // with --delay-ms: when the node's latest frame arrives
 
   Client* find(int fd) {
     for (auto& c : clients)
@@ -375,7 +376,12 @@ struct SocketcandServer::Impl {
       const can::CanFrame frame = outbox.front();
       outbox.pop_front();
       CanMicros due = bus.reserve(at, frame.len);
-      if (faults.delays()) due += std::chrono::duration_cast<CanMicros>(faults.reply_delay());
+      if (faults.delays()) {
+        // Late, but in order: a bus never reorders one sender's frames (random delays
+        // would, and every status snapshot would arrive scrambled).
+        due = std::max(due + std::chrono::duration_cast<CanMicros>(faults.reply_delay()), last_delayed_due);
+        last_delayed_due = due;
+      }
       insert_to_hosts({due, frame, -1});
     }
   }

@@ -80,12 +80,18 @@ class Run : public ::testing::Test {
     fs::remove_all(dir_);
   }
 
-  // The bracket planned once at 0.5 mm into DIR/plan (shared by the tests of one process).
+  // The bracket planned once at 0.5 mm into DIR/plan (shared by the tests of one process,
+  // removed when it exits). Three plans: the third deposits, then mills with three tools.
   static fs::path plan() {
+    struct PlanDir {
+      fs::path dir = fs::temp_directory_path() / ("hybridctl-run-plan-" + std::to_string(::getpid()));
+      ~PlanDir() { fs::remove_all(dir); }
+    };
+    static const PlanDir plan_dir;
     static const fs::path p = [] {
-      const fs::path d = fs::temp_directory_path() / ("hybridctl-run-plan-" + std::to_string(::getpid()));
+      const fs::path d = plan_dir.dir;
       const std::string cmd = command({"plan", (kSource / "examples/parts/bracket.stl").string(), "--machine", kMachine,
-                                       "--voxel", "0.5", "--top", "1", "-o", (d / "plan").string()}) +
+                                       "--voxel", "0.5", "--top", "3", "-o", (d / "plan").string()}) +
                               " >/dev/null 2>&1";
       EXPECT_EQ(std::system(cmd.c_str()), 0);
       return d / "plan" / "plan.json";
@@ -180,6 +186,44 @@ TEST_F(Run, ASimulatorRebootMidActionResumesAtTheSafePoint) {
   EXPECT_NE(slurp(dir_ / "run.err").find("controller restarted (boot 2): its buffer was lost; resending from line 12001"),
             std::string::npos)
       << slurp(dir_ / "run.err");
+}
+
+// Deposition, then three milling tools, on the stock as the simulator built it (beads spill
+// past the plan's voxels): every rapid clears the material really there, so the program
+// runs to its end without RAPID_INTO_MATERIAL and with every line once.
+TEST_F(Run, AMillingPlanRunsOnTheStockAsDeposited) {
+  int port = 0;
+  auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "0", "--plan", "3"}, "modbus-tcp", port);
+  EXPECT_EQ(run({"run", plan().string(), "--plan", "3", "--machine", kMachine, "--transport",
+                 "modbus-tcp://127.0.0.1:" + std::to_string(port), "--job", (dir_ / "job").string(), "--yes"}),
+            0)
+      << slurp(dir_ / "run.out") << slurp(dir_ / "run.err");
+  expect_exactly_once(*sim);
+  const std::string out = slurp(dir_ / "run.out");
+  EXPECT_NE(out.find("subtractive milling with T3"), std::string::npos) << out;
+  const std::string report = slurp(dir_ / "report.json");
+  EXPECT_TRUE(std::regex_search(report, std::regex(R"("final_status":\s*\{[^}]*"state":\s*"COMPLETED")"))) << report;
+}
+
+// A third of the requests dropped at random (and replies damaged and late, and two
+// reboots): runs of failures longer than the transport's own resends happen, and the
+// stream rides them out from the controller's status instead of giving up.
+TEST_F(Run, HeavyRandomFaultsAreRiddenOutExactlyOnce) {
+  int port = 0;
+  auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "0", "--fault-seed", "11", "--drop-every", "3",
+                    "--corrupt-every", "40", "--delay-ms", "2", "--reboot-after-lines", "9000,21000"},
+                   "modbus-tcp", port);
+  EXPECT_EQ(run({"run", plan().string(), "--machine", kMachine, "--transport", "modbus-tcp://127.0.0.1:" + std::to_string(port),
+                 "--job", (dir_ / "job").string(), "--yes"}),
+            0)
+      << slurp(dir_ / "run.err");
+  expect_exactly_once(*sim);
+  const std::string out = slurp(dir_ / "run.out");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex("([0-9]+) link failures recovered"))) << out;
+  EXPECT_GE(std::stoi(m[1]), 1) << "no request failed beyond the transport's resends: the fault rate is too low to test this";
+  ASSERT_TRUE(std::regex_search(out, m, std::regex("([0-9]+) reboots seen"))) << out;
+  EXPECT_EQ(std::stoi(m[1]), 2);
 }
 
 TEST_F(Run, AHostKilledMidProgramResumesFromItsJournal) {
