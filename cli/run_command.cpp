@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -9,6 +10,8 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <vector>
 
 #include "cli/commands.hpp"
 #include "cli/run_job.hpp"
@@ -55,6 +58,36 @@ bool ask(const std::string& question) {
   std::string answer;
   if (!std::getline(std::cin, answer)) return false;
   return !answer.empty() && (answer[0] == 'y' || answer[0] == 'Y');
+}
+
+// What the final report says of one action: when its first and last lines were seen
+// executed (host clock, from the status), and the alarms raised while it ran.
+struct ActionLog {
+  std::uint32_t first = 0, last = 0;  // program lines
+  std::string name;
+  std::optional<Clock::time_point> started, finished;
+  std::vector<std::string> alarms;
+};
+
+std::vector<ActionLog> action_logs(const std::vector<std::string>& lines) {
+  std::vector<ActionLog> out;
+  const auto starts = action_starts(lines);
+  for (std::size_t i = 0; i < starts.size(); ++i) {
+    ActionLog a;
+    a.first = starts[i].first;
+    a.last = i + 1 < starts.size() ? starts[i + 1].first - 1 : std::uint32_t(lines.size());
+    a.name = starts[i].second;
+    out.push_back(std::move(a));
+  }
+  return out;
+}
+
+// The action a program line belongs to (the last one when past the end); null when none.
+ActionLog* action_of(std::vector<ActionLog>& actions, std::uint32_t line) {
+  ActionLog* found = nullptr;
+  for (auto& a : actions)
+    if (a.first <= std::max<std::uint32_t>(line, 1)) found = &a;
+  return found;
 }
 
 // The comment before a program stop: the operator's instructions.
@@ -137,13 +170,23 @@ int run_job(const RunRequest& request) {
   std::fflush(stdout);
 
   auto transport = drivers::open_transport(header.transport);
-  const auto actions = action_starts(lines);
+  std::vector<ActionLog> actions = action_logs(lines);
   const bool tty = ::isatty(STDERR_FILENO) == 1;
   const auto begun = Clock::now();
   auto last_print = Clock::now() - std::chrono::seconds(10);
+  auto add_alarm = [&](const protocol::Status& s) {
+    if (s.alarm == protocol::AlarmCode::None) return;
+    if (ActionLog* a = action_of(actions, s.alarm_line ? s.alarm_line : s.last_executed_line + 1))
+      a->alarms.emplace_back(protocol::to_string(s.alarm));
+  };
 
   drivers::StreamCallbacks cb;
   cb.status = [&](const protocol::Status& s) {
+    const auto now = Clock::now();
+    for (auto& a : actions) {
+      if (!a.started && s.last_executed_line >= a.first) a.started = now;
+      if (!a.finished && s.last_executed_line >= a.last) a.finished = now;
+    }
     const double every = tty ? 0.1 : 2.0;
     if (std::chrono::duration<double>(Clock::now() - last_print).count() < every) return;
     last_print = Clock::now();
@@ -172,6 +215,7 @@ int run_job(const RunRequest& request) {
     return ask("Operator: done? continue the program");
   };
   cb.recover = [&](const protocol::Status& s) {
+    add_alarm(s);
     const auto& info = protocol::alarm_info(s.alarm);
     std::fprintf(stderr, "%salarm %s: %s\n  what to do: %s\n", tty ? "\n" : "", std::string(info.name).c_str(),
                  std::string(info.meaning).c_str(), std::string(info.action).c_str());
@@ -194,13 +238,30 @@ int run_job(const RunRequest& request) {
   const auto tc = transport->counters();
   std::printf("%s after %u of %zu lines in %.1f s (%.0f lines/s)\n", r.completed ? "completed" : "STOPPED",
               r.final_status.last_executed_line, lines.size(), seconds, double(r.final_status.last_executed_line) / std::max(seconds, 1e-9));
-  if (!r.completed) std::printf("why         %s\n", r.stopped_because.c_str());
-  for (std::size_t i = 0; i < actions.size(); ++i) {
-    const std::uint32_t first = actions[i].first;
-    const std::uint32_t last = i + 1 < actions.size() ? actions[i + 1].first - 1 : std::uint32_t(lines.size());
-    const std::uint32_t done = r.final_status.last_executed_line < first ? 0
-                               : std::min(last, r.final_status.last_executed_line) - first + 1;
-    std::printf("  %-60s %u/%u lines\n", actions[i].second.c_str(), done, last - first + 1);
+  if (!r.completed) {
+    std::printf("why         %s\n", r.stopped_because.c_str());
+    add_alarm(r.final_status);
+  }
+  // Per action: lines executed, the time from its first executed line to its last (as the
+  // host saw the status), and the alarms raised in it.
+  const auto end = Clock::now();
+  for (const ActionLog& a : actions) {
+    const std::uint32_t executed = r.final_status.last_executed_line;
+    const std::uint32_t done = executed < a.first ? 0 : std::min(a.last, executed) - a.first + 1;
+    std::string time = "-";
+    if (a.started) time = gcode::format_duration(std::chrono::duration<double>(a.finished.value_or(end) - *a.started).count());
+    // Each alarm once, in the order first raised, with how often when more than once.
+    std::vector<std::pair<std::string, int>> counted;
+    for (const std::string& name : a.alarms) {
+      auto it = std::find_if(counted.begin(), counted.end(), [&](const auto& c) { return c.first == name; });
+      if (it == counted.end()) counted.emplace_back(name, 1);
+      else ++it->second;
+    }
+    std::string alarms;
+    for (std::size_t k = 0; k < counted.size(); ++k)
+      alarms += (k ? ", " : "  alarms ") + counted[k].first +
+                (counted[k].second > 1 ? " x" + std::to_string(counted[k].second) : std::string());
+    std::printf("  %-60s %u/%u lines  %s%s\n", a.name.c_str(), done, a.last - a.first + 1, time.c_str(), alarms.c_str());
   }
   std::printf("counters    chunks %llu sent, %llu accepted, %llu duplicates, %llu refused; %llu reboots seen, %llu alarms "
               "cleared, %llu link failures recovered; transport %llu requests, %llu timeouts, %llu retries, %llu reconnects, "

@@ -186,6 +186,9 @@ TEST_F(Run, ASimulatorRebootMidActionResumesAtTheSafePoint) {
   EXPECT_NE(slurp(dir_ / "run.err").find("controller restarted (boot 2): its buffer was lost; resending from line 12001"),
             std::string::npos)
       << slurp(dir_ / "run.err");
+  // The final report puts the alarm on the action it struck, with the action's lines and time.
+  const std::string out = slurp(dir_ / "run.out");
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(  action 1: .* (\d+)/\1 lines  [0-9.]+ s  alarms CONTROLLER_RESTARTED\n)"))) << out;
 }
 
 // Deposition, then three milling tools, on the stock as the simulator built it (beads spill
