@@ -103,13 +103,18 @@ TEST(CanNode, SendsAStatusSnapshotWhenTheStateChanges) {
   EXPECT_TRUE(bus.snapshots().empty()) << "one snapshot per change";
 }
 
-TEST(CanNode, SendsAStatusSnapshotWhenAFullBufferHasRoomForAChunkAgain) {
+// A controller reached over CAN, executing as fast as it can, with no heartbeat watch.
+ControllerOptions can_controller(std::uint32_t buffer_bytes = 16384) {
   ControllerOptions options;
   options.time_scale = 0;
-  options.buffer_bytes = 6000;
+  options.buffer_bytes = buffer_bytes;
   options.max_chunk_payload = static_cast<std::uint16_t>(can::kMaxChunkPayload);
   options.heartbeat_timeout_s = 0;
-  Bus bus(std::move(options));
+  return options;
+}
+
+TEST(CanNode, SendsAStatusSnapshotWhenAFullBufferHasRoomForAChunkAgain) {
+  Bus bus(can_controller(6000));
   const auto lines = program(400);
   const std::uint64_t identity = protocol::program_identity(lines);
   bus.command(CommandCode::SetProgram, 1, identity, static_cast<std::uint32_t>(lines.size()));
@@ -143,11 +148,7 @@ TEST(CanNode, SendsAStatusSnapshotWhenAFullBufferHasRoomForAChunkAgain) {
 }
 
 TEST(CanNode, SendsAStatusSnapshotWhenTheProgramCompletes) {
-  ControllerOptions options;
-  options.time_scale = 0;
-  options.max_chunk_payload = static_cast<std::uint16_t>(can::kMaxChunkPayload);
-  options.heartbeat_timeout_s = 0;
-  Bus bus(std::move(options));
+  Bus bus(can_controller());
   const auto lines = program(20);
   const std::uint64_t identity = protocol::program_identity(lines);
   bus.command(CommandCode::SetProgram, 1, identity, static_cast<std::uint32_t>(lines.size()));
