@@ -13,7 +13,10 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <sstream>
 #include <system_error>
+
+#include <yaml-cpp/eventhandler.h>
 
 #include "config/transport_uri.hpp"
 #include "config/yaml_reader.hpp"
@@ -707,6 +710,28 @@ class Loader {
   std::vector<HeadToolNumber> head_tool_numbers_;
 };
 
+/// Where each document of a stream starts; the parser's events are otherwise ignored.
+///
+/// yaml-cpp 0.7 reads a document that starts with a token no value can start with (a stray
+/// ',', say) as null without consuming that token, so YAML::LoadAll calls the parser again
+/// and again on it, allocating without end (jbeder/yaml-cpp#1040, fixed in 0.8). The loader
+/// takes at most two parser steps instead: the first document, and whether another follows
+/// (one that starts where the first did is that stuck token).
+class DocumentStarts final : public YAML::EventHandler {
+ public:
+  std::vector<YAML::Mark> marks;
+
+  void OnDocumentStart(const YAML::Mark& mark) override { marks.push_back(mark); }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+};
+
 }  // namespace
 
 Machine parse_machine(std::string_view yaml_text, std::string file_name) {
@@ -715,16 +740,25 @@ Machine parse_machine(std::string_view yaml_text, std::string file_name) {
   constexpr std::string_view kExpectedDocument =
       "expected a mapping with at least name, envelope, setups and heads or tools (see docs/machine-file.md)";
   try {
-    const std::vector<YAML::Node> documents = YAML::LoadAll(std::string(yaml_text));
-    if (documents.empty() || documents.front().IsNull()) {
+    const std::string text(yaml_text);
+    std::istringstream stream(text);
+    YAML::Parser parser(stream);
+    DocumentStarts starts;
+    const bool second = parser.HandleNextDocument(starts) && parser.HandleNextDocument(starts);
+    const YAML::Node document = YAML::Load(text);  // the first document
+    if (second && starts.marks[1].pos == starts.marks[0].pos) {
+      const auto at = static_cast<std::size_t>(std::max(starts.marks[0].pos, 0));
+      sink.error(starts.marks[0], "YAML syntax error: found '" + printable(yaml_text.substr(at, 1)) +
+                                      "', which starts no value; " + std::string(kExpectedDocument));
+    } else if (!document || document.IsNull()) {
       sink.error(YAML::Mark::null_mark(), "empty machine file; " + std::string(kExpectedDocument));
     } else {
-      if (documents.size() > 1)
-        sink.error(documents[1].Mark(), "a machine file holds one YAML document; expected no second document here");
-      if (!documents.front().IsMap())
-        sink.error(documents.front().Mark(), std::string(kExpectedDocument) + ", got " + describe(documents.front()));
+      if (second)
+        sink.error(starts.marks[1], "a machine file holds one YAML document; expected no second document here");
+      if (!document.IsMap())
+        sink.error(document.Mark(), std::string(kExpectedDocument) + ", got " + describe(document));
       else
-        machine = Loader(sink).load(documents.front());
+        machine = Loader(sink).load(document);
     }
   } catch (const YAML::Exception& e) {
     sink.error(e.mark, "YAML syntax error: " + e.msg);

@@ -205,6 +205,20 @@ TEST(MachineErrors, EmptyFileAndCommentOnlyFile) {
   expect_one("# nothing but a comment\n\n", "m.yaml:1:1: ", {"empty machine file"});
 }
 
+TEST(MachineErrors, AStrayCommaIsASyntaxErrorNotAnEndlessLoop) {
+  // Found by fuzz/machine_fuzz (fuzz/corpus/machine/regression-stray-comma.yaml): yaml-cpp
+  // 0.7's LoadAll looped forever, allocating, on a document starting with ','.
+  expect_one(",", "m.yaml:1:1: ", {"YAML syntax error: found ',', which starts no value", "expected a mapping"});
+  expect_one("# machine\n  , name: x\n", "m.yaml:2:3: ", {"YAML syntax error: found ','"});
+  expect_one(kBase + "---\n,\n", "m.yaml:12:1: ", {"one YAML document; expected no second document here"});
+}
+
+TEST(MachineErrors, ASecondDocumentIsReportedWhereItStarts) {
+  const auto ds = problems(kBase + "---\nname: other\n");
+  ASSERT_EQ(ds.size(), 1u) << all(ds);
+  EXPECT_EQ(ds[0].str(), "m.yaml:12:1: a machine file holds one YAML document; expected no second document here");
+}
+
 TEST(MachineErrors, DocumentThatIsNotAMapping) {
   expect_one("just a scalar\n", "m.yaml:1:1: ", {"expected a mapping", "got 'just a scalar'"});
   expect_one("- a\n- b\n", "m.yaml:1:1: ", {"expected a mapping", "got a list"});
