@@ -1,5 +1,5 @@
 // Fuzz target: the simulator's side of socketcand's text protocol (sim/socketcand_server.hpp):
-// the input split into elements the way the server splits a client's stream (text outside
+// the input split into elements by the server's own split_socketcand_stream (text outside
 // `< >` and unclosed elements are errors), each parsed by parse_socketcand_element; and
 // the two sides against each other: a `< send >` frame the server accepts, written back as
 // the server's `< frame >` element (format_socketcand_frame), must read the same on the
@@ -57,24 +57,23 @@ void check_element(std::string_view element) {
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view in(reinterpret_cast<const char*>(data), size);
-  // The server's split (SocketcandServer's client reader): whitespace between elements,
-  // garbage up to the next '<', an element ends at the first '>' unless a '<' comes first.
-  std::size_t i = 0;
-  while (i < in.size()) {
-    if (in[i] != '<') {
-      ++i;
-      continue;
+  // The server's own split of a client's stream (split_socketcand_stream, what
+  // SocketcandServer reads a client with): pieces lie inside the input, in order, and every
+  // element is checked.
+  const char* last_end = in.data();
+  const std::size_t used = sim::split_socketcand_stream(in, 256, [&](const sim::SocketcandPiece& piece) {
+    FUZZ_CHECK(piece.text.data() >= last_end && piece.text.data() + piece.text.size() <= in.data() + in.size(),
+               "pieces lie inside the input, in order");
+    FUZZ_CHECK(!piece.text.empty(), "no empty piece");
+    last_end = piece.text.data() + piece.text.size();
+    if (piece.kind == sim::SocketcandPiece::Kind::Element) {
+      FUZZ_CHECK(piece.text.front() == '<' && piece.text.back() == '>', "an element is bracketed");
+      check_element(piece.text);
     }
-    const std::size_t close = in.find('>', i);
-    const std::size_t nested = in.find('<', i + 1);
-    if (nested != std::string_view::npos && (close == std::string_view::npos || nested < close)) {
-      i = nested;
-      continue;
-    }
-    if (close == std::string_view::npos) break;
-    check_element(in.substr(i, close - i + 1));
-    i = close + 1;
-  }
+    return true;
+  });
+  FUZZ_CHECK(used <= in.size(), "the split uses at most the input");
+  FUZZ_CHECK(used == in.size() || in[used] == '<', "what waits for more input is an element's start");
   // Each input is also one element as a whole, brackets or not.
   check_element(in);
   return 0;

@@ -77,6 +77,42 @@ bool valid_channel(std::string_view name) {
 
 }  // namespace
 
+std::size_t split_socketcand_stream(std::string_view in, std::size_t max_element,
+                                   const std::function<bool(const SocketcandPiece&)>& on_piece) {
+  using K = SocketcandPiece::Kind;
+  std::size_t i = 0;
+  while (i < in.size()) {
+    if (std::isspace(static_cast<unsigned char>(in[i]))) {
+      ++i;
+      continue;
+    }
+    SocketcandPiece piece{K::Element, {}};
+    std::size_t next = 0;
+    if (in[i] != '<') {
+      const std::size_t lt = in.find('<', i);
+      next = lt == std::string_view::npos ? in.size() : lt;
+      piece = {K::Garbage, in.substr(i, next - i)};
+    } else {
+      const std::size_t close = in.find('>', i);
+      const std::size_t nested = in.find('<', i + 1);
+      if (nested != std::string_view::npos && (close == std::string_view::npos || nested < close)) {
+        next = nested;
+        piece = {K::Unclosed, in.substr(i, nested - i)};
+      } else if (close == std::string_view::npos) {
+        if (in.size() - i <= max_element) return i;  // wait for the rest
+        next = in.size();
+        piece = {K::Overlong, in.substr(i)};
+      } else {
+        next = close + 1;
+        piece = {K::Element, in.substr(i, next - i)};
+      }
+    }
+    i = next;
+    if (!on_piece(piece)) return i;
+  }
+  return i;
+}
+
 SocketcandParse parse_socketcand_element(std::string_view element) {
   SocketcandParse out;
   if (element.size() < 2 || element.front() != '<' || element.back() != '>') {
@@ -287,46 +323,31 @@ struct SocketcandServer::Impl {
 
   // Takes every whole element out of c.in.
   void parse_input(Client& c, CanMicros now) {
-    std::size_t i = 0;
-    const std::string& in = c.in;
-    while (i < in.size() && !c.closing) {
-      const auto u = static_cast<unsigned char>(in[i]);
-      if (std::isspace(u)) {
-        ++i;
-        continue;
-      }
-      if (in[i] != '<') {
-        // Garbage up to the next '<': one error for the run.
-        const std::size_t next = in.find('<', i);
-        const std::size_t end = next == std::string::npos ? in.size() : next;
-        error(c, "unexpected text '" + quote(std::string_view(in).substr(i, end - i)) +
-                     "' outside an element, expected an element between angle brackets");
-        i = end;
-        continue;
-      }
-      const std::size_t close = in.find('>', i);
-      const std::size_t nested = in.find('<', i + 1);
-      if (nested != std::string::npos && (close == std::string::npos || nested < close)) {
-        error(c, "element '" + quote(std::string_view(in).substr(i, nested - i)) + "' is not closed before the next one opens");
-        i = nested;
-        continue;
-      }
-      if (close == std::string::npos) {
-        if (in.size() - i > kMaxElement) {
-          error(c, "element longer than " + std::to_string(kMaxElement) + " characters without its end");
-          i = in.size();
+    using K = SocketcandPiece::Kind;
+    const std::size_t used = split_socketcand_stream(c.in, kMaxElement, [&](const SocketcandPiece& piece) {
+      switch (piece.kind) {
+        case K::Element: {
+          const SocketcandParse p = parse_socketcand_element(piece.text);
+          if (p.request) {
+            handle(c, *p.request, now);
+          } else {
+            error(c, p.error);
+          }
+          break;
         }
-        break;  // wait for the rest
+        case K::Garbage:  // one error for the run
+          error(c, "unexpected text '" + quote(piece.text) + "' outside an element, expected an element between angle brackets");
+          break;
+        case K::Unclosed:
+          error(c, "element '" + quote(piece.text) + "' is not closed before the next one opens");
+          break;
+        case K::Overlong:
+          error(c, "element longer than " + std::to_string(kMaxElement) + " characters without its end");
+          break;
       }
-      const SocketcandParse p = parse_socketcand_element(std::string_view(in).substr(i, close - i + 1));
-      if (p.request) {
-        handle(c, *p.request, now);
-      } else {
-        error(c, p.error);
-      }
-      i = close + 1;
-    }
-    c.in.erase(0, i);
+      return !c.closing;
+    });
+    c.in.erase(0, used);
   }
 
   void deliver(const BusFrame& f, SteadyTime now) {

@@ -29,6 +29,7 @@
 // controller discards a frame with a CRC error; delay_ms holds the node's frames back.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -105,6 +106,25 @@ struct SocketcandParse {
 
 /// Parses one element, "<" to ">" inclusive.
 SocketcandParse parse_socketcand_element(std::string_view element);
+
+/// One piece of a client's stream, as the server splits it.
+struct SocketcandPiece {
+  enum class Kind {
+    Element,   ///< "<" to the next ">", with no "<" between
+    Garbage,   ///< text outside an element, up to the next "<" (whitespace is skipped)
+    Unclosed,  ///< "<" up to (not including) another "<" that comes before any ">"
+    Overlong,  ///< an element still open after max_element bytes: the rest of the input
+  };
+  Kind kind;
+  std::string_view text;
+};
+
+/// Splits the complete pieces at the front of `in` (a client's stream so far), calling
+/// `on_piece` for each until it returns false; returns how many bytes of `in` were used.
+/// An element not yet closed at the end waits for more input (not used), unless it is
+/// already longer than `max_element`.
+std::size_t split_socketcand_stream(std::string_view in, std::size_t max_element,
+                                   const std::function<bool(const SocketcandPiece&)>& on_piece);
 
 /// "< frame ID SEC.USEC DATAHEX >" for a frame received at wall-clock time sec.usec.
 std::string format_socketcand_frame(const protocol::can::CanFrame& frame, long sec, long usec);

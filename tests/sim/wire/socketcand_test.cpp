@@ -190,6 +190,35 @@ TEST(SocketcandText, RefusesMalformedElementsSayingWhy) {
   }
 }
 
+TEST(SocketcandText, SplitsAClientStreamIntoElementsAndWhatIsRefused) {
+  using K = sim::SocketcandPiece::Kind;
+  const std::string in = "  < open can0 >junk <send 123 0 ><unclosed < rawmode >\n< partial";
+  std::vector<std::pair<K, std::string>> pieces;
+  const std::size_t used = sim::split_socketcand_stream(in, 256, [&](const sim::SocketcandPiece& p) {
+    pieces.emplace_back(p.kind, std::string(p.text));
+    return true;
+  });
+  const std::vector<std::pair<K, std::string>> expected = {{K::Element, "< open can0 >"},
+                                                           {K::Garbage, "junk "},
+                                                           {K::Element, "<send 123 0 >"},
+                                                           {K::Unclosed, "<unclosed "},
+                                                           {K::Element, "< rawmode >"}};
+  EXPECT_EQ(pieces, expected);
+  EXPECT_EQ(in.substr(used), "< partial") << "an element not yet closed waits for more input";
+
+  // Too long to be an element: given up on; a false from the callback stops the split.
+  const std::string overlong = "<" + std::string(300, 'x');
+  pieces.clear();
+  EXPECT_EQ(sim::split_socketcand_stream(overlong, 256, [&](const sim::SocketcandPiece& p) {
+              pieces.emplace_back(p.kind, std::string(p.text));
+              return true;
+            }),
+            overlong.size());
+  ASSERT_EQ(pieces.size(), 1u);
+  EXPECT_EQ(pieces[0].first, K::Overlong);
+  EXPECT_EQ(sim::split_socketcand_stream("<echo><echo>", 256, [](const sim::SocketcandPiece&) { return false; }), 6u);
+}
+
 TEST(SocketcandText, FormatsFramesAsTheDaemonDoes) {
   protocol::can::CanFrame f;
   f.id = 0x181;
