@@ -182,17 +182,17 @@ TEST(MaterialSimulation, ARapidGrazingMaterialWithTheHolderIsAnIncidentToo) {
 }
 
 TEST(MaterialSimulation, AHolderOrShankInMaterialIsACollisionOnThatLine) {
-  const Cutter stubby = cutter_of(tool(config::ToolType::Flat, 4, 3, {4, 2}, {20, 30}));
+  const Cutter short_fluted = cutter_of(tool(config::ToolType::Flat, 4, 3, {4, 2}, {20, 30}));
   {
     // Tip 6 mm below the top: flutes reach 7, shank 7..9, holder from 9 mm: both drag
     // through material.
     MaterialSimulation sim(full_stock());
-    const MoveReport r = sim.cut(stubby, feed({3, 10, 4}, {17, 10, 4}, 7));
+    const MoveReport r = sim.cut(short_fluted, feed({3, 10, 4}, {17, 10, 4}, 7));
     ASSERT_EQ(r.incidents.size(), 1u);
     EXPECT_EQ(r.incidents.front().kind, IncidentKind::BodyCollision);
     EXPECT_EQ(r.incidents.front().line, 7);
-    const Solid cut = swept_volume(pieces_of(stubby.cutting), {{3, 10, 4}, {17, 10, 4}}, kLattice, kStockBox);
-    const Solid body = swept_volume(pieces_of(stubby.body), {{3, 10, 4}, {17, 10, 4}}, kLattice, kStockBox);
+    const Solid cut = swept_volume(pieces_of(short_fluted.cutting), {{3, 10, 4}, {17, 10, 4}}, kLattice, kStockBox);
+    const Solid body = swept_volume(pieces_of(short_fluted.body), {{3, 10, 4}, {17, 10, 4}}, kLattice, kStockBox);
     const Solid touched = geometry::subtract(geometry::intersect(body, full_stock()), cut);
     EXPECT_EQ(r.incidents.front().voxels, touched.voxel_count());
     EXPECT_DOUBLE_EQ(r.collision, touched.volume());
@@ -201,7 +201,7 @@ TEST(MaterialSimulation, AHolderOrShankInMaterialIsACollisionOnThatLine) {
   {
     // 2 mm deep: the flutes reach past the top, nothing else touches.
     MaterialSimulation sim(full_stock());
-    EXPECT_TRUE(sim.cut(stubby, feed({3, 10, 8}, {17, 10, 8}, 8)).incidents.empty());
+    EXPECT_TRUE(sim.cut(short_fluted, feed({3, 10, 8}, {17, 10, 8}, 8)).incidents.empty());
     EXPECT_GT(sim.report().removed, 0);
   }
   {
