@@ -1,6 +1,6 @@
 // Program streaming over CAN through socketcand against `hybridctl sim serve
 // --can-bitrate 1000000` (the simulator delivers every frame, both directions, as a
-// 1 Mbit/s classic CAN bus would: sim/can_node.hpp, can_frame_time), at time scale 0.
+// 1 Mbit/s classic CAN bus would: sim/wire/can_node.hpp, can_frame_time), at time scale 0.
 //
 // Two figures in the same run, on the same simulated bus:
 //  - BM_RawBusFrames: the bus itself. One socketcand client puts 8-byte frames on an
@@ -27,12 +27,12 @@
 
 #include "bench/bench_process.hpp"
 #include "drivers/journal.hpp"
-#include "drivers/protocol/chunk.hpp"
-#include "drivers/protocol/messages.hpp"
+#include "protocol/chunk.hpp"
+#include "protocol/messages.hpp"
 #include "drivers/socketcand_transport.hpp"
 #include "drivers/streamer.hpp"
 #include "drivers/transport.hpp"
-#include "sim/can_node.hpp"
+#include "sim/wire/can_node.hpp"
 
 namespace {
 

@@ -11,8 +11,8 @@
 
 #include <cmath>
 
-#include "gcode/deposition_path.hpp"
-#include "gcode/pocket_path.hpp"
+#include "toolpaths/deposition_path.hpp"
+#include "toolpaths/pocket_path.hpp"
 #include "geometry/shapes.hpp"
 
 namespace {
@@ -88,34 +88,34 @@ void BM_Deposition(benchmark::State& state) {
   const Solid base = geometry::make_box(kLattice, {{0, 0, 0}, {60, 60, 5}});
   Solid roi = geometry::make_box(kLattice, {{5, 5, 5}, {55, 55, 55}});
   roi = geometry::subtract(roi, geometry::make_cylinder(kLattice, geometry::Axis::Z, {30, 30, 0}, 8, 60));
-  gcode::DepositionOptions o;
-  if (state.range(0)) o.contour = gcode::ContourPass::BeforeInfill;
+  toolpaths::DepositionOptions o;
+  if (state.range(0)) o.contour = toolpaths::ContourPass::BeforeInfill;
   gcode::Toolpath p;
   for (auto _ : state) {
-    p = gcode::deposition_path(roi, base, ded(), top(), o);
+    p = toolpaths::deposition_path(roi, base, ded(), top(), o);
     benchmark::DoNotOptimize(p.moves.data());
   }
   count(state, p, roi);
 }
 
-void pocket(benchmark::State& state, const config::CuttingTool& tool, gcode::PocketStrategy strategy) {
+void pocket(benchmark::State& state, const config::CuttingTool& tool, toolpaths::PocketStrategy strategy) {
   const Solid stock = geometry::make_box(kLattice, {{0, 0, 0}, {60, 60, 55}});
   Solid roi = geometry::make_box(kLattice, {{5, 5, 5}, {55, 55, 55}});
   roi = geometry::subtract(roi, geometry::make_cylinder(kLattice, geometry::Axis::Z, {30, 30, 0}, 8, 60));
   const Solid keep = geometry::subtract(stock, roi);
-  gcode::PocketOptions o;
+  toolpaths::PocketOptions o;
   o.strategy = strategy;
   gcode::Toolpath p;
   for (auto _ : state) {
-    p = gcode::pocket_path(roi, keep, stock, tool, top(), o);
+    p = toolpaths::pocket_path(roi, keep, stock, tool, top(), o);
     benchmark::DoNotOptimize(p.moves.data());
   }
   count(state, p, roi);
 }
 
-void BM_PocketZigzag_Rougher(benchmark::State& s) { pocket(s, rougher(), gcode::PocketStrategy::Zigzag); }
-void BM_PocketOffsets_Rougher(benchmark::State& s) { pocket(s, rougher(), gcode::PocketStrategy::Offsets); }
-void BM_PocketZigzag_Detail(benchmark::State& s) { pocket(s, detail(), gcode::PocketStrategy::Zigzag); }
+void BM_PocketZigzag_Rougher(benchmark::State& s) { pocket(s, rougher(), toolpaths::PocketStrategy::Zigzag); }
+void BM_PocketOffsets_Rougher(benchmark::State& s) { pocket(s, rougher(), toolpaths::PocketStrategy::Offsets); }
+void BM_PocketZigzag_Detail(benchmark::State& s) { pocket(s, detail(), toolpaths::PocketStrategy::Zigzag); }
 
 }  // namespace
 

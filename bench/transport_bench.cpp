@@ -24,9 +24,9 @@
 #include <vector>
 
 #include "bench/bench_process.hpp"
-#include "drivers/protocol/chunk.hpp"
-#include "drivers/protocol/messages.hpp"
-#include "drivers/protocol/modbus_map.hpp"
+#include "protocol/chunk.hpp"
+#include "protocol/messages.hpp"
+#include "protocol/modbus_map.hpp"
 #include "drivers/transport.hpp"
 
 namespace {

@@ -11,7 +11,7 @@
 #include "config/machine_loader.hpp"
 #include "gcode/check.hpp"
 #include "gcode/files.hpp"
-#include "gcode/plan_export.hpp"
+#include "toolpaths/plan_export.hpp"
 #include "gcode/tool_table.hpp"
 
 namespace hybridctl::cli {
@@ -28,7 +28,7 @@ int export_plan_programs(const ExportRequest& request) {
                      " (the plans in " + request.plan + ")");
   const planner::PlanFilePlan& plan = file.plans[std::size_t(request.rank - 1)];
 
-  gcode::ExportOptions options;
+  toolpaths::ExportOptions options;
   if (!request.dialect.empty()) {
     if (request.dialect == "rs274ngc" || request.dialect == "linuxcnc") {
       options.post.dialect = config::Dialect::Rs274ngc;
@@ -42,7 +42,7 @@ int export_plan_programs(const ExportRequest& request) {
   options.post.program_name = name + " " + plan.expression;
   ProgressBar bar("toolpaths");
   options.progress = [&](int action, int actions) { bar.update(double(action - 1) / double(actions)); };
-  const gcode::PlanExport exported = gcode::export_plan(file, plan, machine, options);
+  const toolpaths::PlanExport exported = toolpaths::export_plan(file, plan, machine, options);
   bar.finish();
 
   const std::vector<gcode::ActionProgram> programs = exported.programs();
@@ -53,7 +53,7 @@ int export_plan_programs(const ExportRequest& request) {
 
   std::printf("plan        %d: %s  cost %.4f\n", request.rank, plan.expression.c_str(), plan.cost);
   std::size_t next = 0;
-  for (const gcode::ExportedAction& a : exported.actions) {
+  for (const toolpaths::ExportedAction& a : exported.actions) {
     if (!a.makes_gcode) {
       std::printf("  %d) %-4s %s\n", a.step, a.primitive.c_str(), a.note.c_str());
       continue;

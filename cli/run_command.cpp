@@ -18,11 +18,11 @@
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
 #include "drivers/journal.hpp"
-#include "drivers/protocol/chunk.hpp"
+#include "protocol/chunk.hpp"
 #include "drivers/streamer.hpp"
 #include "gcode/check.hpp"
 #include "gcode/files.hpp"
-#include "gcode/plan_export.hpp"
+#include "toolpaths/plan_export.hpp"
 
 namespace hybridctl::cli {
 namespace {
@@ -130,7 +130,7 @@ int run_job(const RunRequest& request) {
       const auto& plan = file.plans[std::size_t(request.rank - 1)];
       gcode::PostOptions post;
       post.program_name = "plan-" + std::to_string(request.rank) + " " + plan.expression;
-      text = gcode::write_program(gcode::export_plan(file, plan, machine).programs(), machine, post);
+      text = gcode::write_program(toolpaths::export_plan(file, plan, machine).programs(), machine, post);
       header.source = in.string() + " plan " + std::to_string(request.rank);
     } else {
       text = gcode::read_text_file(in);

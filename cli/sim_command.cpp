@@ -15,24 +15,24 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.hpp"
-#include "drivers/protocol/can_transfer.hpp"
-#include "drivers/protocol/modbus_map.hpp"
+#include "protocol/can_transfer.hpp"
+#include "protocol/modbus_map.hpp"
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
 #include "config/transport_uri.hpp"
-#include "drivers/protocol/codes.hpp"
+#include "protocol/codes.hpp"
 #include "geometry/mesh.hpp"
 #include "geometry/morphology.hpp"
 #include "geometry/surface_mesh.hpp"
 #include "geometry/vdb_file.hpp"
 #include "planner/plan_file.hpp"
 #include "sim/controller.hpp"
-#include "sim/fault_injection.hpp"
-#include "sim/modbus_server.hpp"
-#include "sim/serve_loop.hpp"
-#include "sim/socketcan_endpoint.hpp"
-#include "sim/socketcand_server.hpp"
+#include "sim/wire/fault_injection.hpp"
+#include "sim/wire/modbus_server.hpp"
+#include "sim/wire/serve_loop.hpp"
+#include "sim/wire/socketcan_endpoint.hpp"
+#include "sim/wire/socketcand_server.hpp"
 
 namespace hybridctl::cli {
 namespace {

@@ -13,8 +13,8 @@
 #include <thread>
 
 #include "cli/commands.hpp"
-#include "drivers/protocol/codes.hpp"
-#include "drivers/protocol/messages.hpp"
+#include "protocol/codes.hpp"
+#include "protocol/messages.hpp"
 #include "drivers/transport.hpp"
 
 namespace hybridctl::cli {

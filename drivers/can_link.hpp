@@ -28,8 +28,8 @@
 #include <span>
 #include <string>
 
-#include "drivers/protocol/can_frames.hpp"
-#include "drivers/protocol/can_transfer.hpp"
+#include "protocol/can_frames.hpp"
+#include "protocol/can_transfer.hpp"
 #include "drivers/transport.hpp"
 
 namespace hybridctl::drivers {

@@ -14,7 +14,7 @@
 #include "common/error.hpp"
 #include "config/transport_uri.hpp"
 #include "drivers/backoff.hpp"
-#include "drivers/protocol/modbus_map.hpp"
+#include "protocol/modbus_map.hpp"
 
 namespace hybridctl::drivers {
 namespace {

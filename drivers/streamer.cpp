@@ -5,8 +5,8 @@
 
 #include "common/error.hpp"
 #include "drivers/journal.hpp"
-#include "drivers/protocol/chunk.hpp"
-#include "drivers/protocol/chunk_acceptor.hpp"
+#include "protocol/chunk.hpp"
+#include "protocol/chunk_acceptor.hpp"
 
 namespace hybridctl::drivers {
 namespace {

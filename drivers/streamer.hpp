@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "drivers/protocol/messages.hpp"
+#include "protocol/messages.hpp"
 #include "drivers/transport.hpp"
 
 namespace hybridctl::drivers {

@@ -20,8 +20,8 @@
 
 #include <string_view>
 
-#include "drivers/protocol/chunk.hpp"
-#include "drivers/protocol/messages.hpp"
+#include "protocol/chunk.hpp"
+#include "protocol/messages.hpp"
 
 namespace hybridctl::config {
 struct Transport;

@@ -24,9 +24,9 @@
 #include <optional>
 #include <vector>
 
-#include "drivers/protocol/can_frames.hpp"
-#include "drivers/protocol/can_transfer.hpp"
-#include "drivers/protocol/chunk_acceptor.hpp"
+#include "protocol/can_frames.hpp"
+#include "protocol/can_transfer.hpp"
+#include "protocol/chunk_acceptor.hpp"
 #include "fuzz/byte_reader.hpp"
 #include "fuzz/fuzz_check.hpp"
 

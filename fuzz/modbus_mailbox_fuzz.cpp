@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
-#include "drivers/protocol/chunk_acceptor.hpp"
-#include "drivers/protocol/messages.hpp"
-#include "drivers/protocol/modbus_map.hpp"
+#include "protocol/chunk_acceptor.hpp"
+#include "protocol/messages.hpp"
+#include "protocol/modbus_map.hpp"
 #include "fuzz/byte_reader.hpp"
 #include "fuzz/fuzz_check.hpp"
 

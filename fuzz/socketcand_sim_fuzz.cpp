@@ -1,4 +1,4 @@
-// Fuzz target: the simulator's side of socketcand's text protocol (sim/socketcand_server.hpp):
+// Fuzz target: the simulator's side of socketcand's text protocol (sim/wire/socketcand_server.hpp):
 // the input split into elements by the server's own split_socketcand_stream (text outside
 // `< >` and unclosed elements are errors), each parsed by parse_socketcand_element; and
 // the two sides against each other: a `< send >` frame the server accepts, written back as
@@ -15,7 +15,7 @@
 
 #include "drivers/socketcand_transport.hpp"
 #include "fuzz/fuzz_check.hpp"
-#include "sim/socketcand_server.hpp"
+#include "sim/wire/socketcand_server.hpp"
 
 namespace can = hybridctl::protocol::can;
 namespace drivers = hybridctl::drivers;

@@ -1,6 +1,6 @@
 #pragma once
 // The dialect-neutral toolpath of one plan action: moves in the setup's work frame, as
-// the toolpath generators (gcode/deposition_path, gcode/pocket_path) produce them and the
+// the toolpath generators (toolpaths/deposition_path, toolpaths/pocket_path) produce them and the
 // post-processor (gcode/post) writes them out in a machine's dialect.
 //
 // Frames: the part frame is the design's (STL) frame. A setup looks at the part from its

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "drivers/protocol/modbus_map.hpp"
+#include "protocol/modbus_map.hpp"
 #include "sim/executor.hpp"
 
 namespace hybridctl::sim {

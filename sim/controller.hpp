@@ -1,6 +1,6 @@
 #pragma once
 // The simulated machine controller: what sits behind the wire in `hybridctl sim serve`.
-// It owns the program buffer (the protocol's acceptance rule, drivers/protocol), executes
+// It owns the program buffer (the protocol's acceptance rule, protocol/), executes
 // the G-code in virtual time with the machine's feed and acceleration limits, keeps
 // position, tool, spindle and deposition state, applies the material simulation to a
 // voxel stock, and raises the alarms a real controller would.
@@ -24,8 +24,8 @@
 #include <vector>
 
 #include "config/machine.hpp"
-#include "drivers/protocol/chunk_acceptor.hpp"
-#include "drivers/protocol/messages.hpp"
+#include "protocol/chunk_acceptor.hpp"
+#include "protocol/messages.hpp"
 #include "geometry/solid.hpp"
 
 namespace hybridctl::sim {

@@ -4,7 +4,7 @@
 
 #include "common/error.hpp"
 #include "gcode/check.hpp"
-#include "gcode/setup_frame.hpp"
+#include "toolpaths/setup_frame.hpp"
 #include "sim/instrument.hpp"
 
 namespace hybridctl::sim {
@@ -17,9 +17,9 @@ using geometry::Solid;
 // so the simulated world keeps its extent.
 Solid turned(const Solid& solid, const IndexBox& domain, config::Approach approach, bool to_work) {
   if (approach == config::Approach::PlusZ) return solid;
-  const IndexBox box = to_work ? gcode::part_to_work(domain, solid.lattice(), approach)
-                               : gcode::work_to_part(domain, solid.lattice(), approach);
-  const Solid t = to_work ? gcode::part_to_work(solid, approach) : gcode::work_to_part(solid, approach);
+  const IndexBox box = to_work ? toolpaths::part_to_work(domain, solid.lattice(), approach)
+                               : toolpaths::work_to_part(domain, solid.lattice(), approach);
+  const Solid t = to_work ? toolpaths::part_to_work(solid, approach) : toolpaths::work_to_part(solid, approach);
   Solid out(solid.lattice(), box);
   t.for_each_voxel([&](geometry::Index3 v) {
     if (box.contains(v)) out.set(v);
@@ -77,7 +77,7 @@ struct ProgramExecutor::Impl {
   void leave_frame() {
     if (!sim) return;
     add(finished, sim->report());
-    part_stock = turned(sim->stock(), gcode::part_to_work(domain, part_stock->lattice(), frame->approach), frame->approach,
+    part_stock = turned(sim->stock(), toolpaths::part_to_work(domain, part_stock->lattice(), frame->approach), frame->approach,
                         false);
     sim.reset();
   }
@@ -107,7 +107,7 @@ Solid ProgramExecutor::stock() const {
   Impl& i = *impl_;
   if (!i.part_stock) return Solid();
   if (!i.sim) return *i.part_stock;
-  return turned(i.sim->stock(), gcode::part_to_work(i.domain, i.part_stock->lattice(), i.frame->approach),
+  return turned(i.sim->stock(), toolpaths::part_to_work(i.domain, i.part_stock->lattice(), i.frame->approach),
                 i.frame->approach, false);
 }
 

@@ -7,7 +7,7 @@
 #include <deque>
 
 #include "drivers/can_link.hpp"
-#include "drivers/protocol/can_frames.hpp"
+#include "protocol/can_frames.hpp"
 
 namespace hybridctl::drivers {
 namespace {

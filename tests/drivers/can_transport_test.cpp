@@ -12,7 +12,7 @@
 
 #include <thread>
 
-#include "drivers/protocol/can_transfer.hpp"
+#include "protocol/can_transfer.hpp"
 #include "drivers/socketcan_transport.hpp"
 #include "drivers/transport.hpp"
 #include "sim_process.hpp"

@@ -12,7 +12,7 @@
 
 #include "common/error.hpp"
 #include "drivers/modbus_transport.hpp"
-#include "drivers/protocol/modbus_map.hpp"
+#include "protocol/modbus_map.hpp"
 #include "drivers/transport.hpp"
 #include "sim_process.hpp"
 #include "transport_fixtures.hpp"

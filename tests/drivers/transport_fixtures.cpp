@@ -8,7 +8,7 @@
 #include <fstream>
 #include <thread>
 
-#include "drivers/protocol/chunk.hpp"
+#include "protocol/chunk.hpp"
 
 namespace hybridctl::test {
 

@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "drivers/protocol/messages.hpp"
+#include "protocol/messages.hpp"
 #include "drivers/transport.hpp"
 
 namespace hybridctl::test {

@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include "config/machine_loader.hpp"
-#include "drivers/protocol/chunk.hpp"
-#include "drivers/protocol/modbus_map.hpp"
+#include "protocol/chunk.hpp"
+#include "protocol/modbus_map.hpp"
 #include "geometry/shapes.hpp"
 #include "sim/controller.hpp"
 

@@ -11,7 +11,7 @@
 
 #include "config/machine_loader.hpp"
 #include "gcode/interpreter.hpp"
-#include "gcode/plan_export.hpp"
+#include "toolpaths/plan_export.hpp"
 #include "geometry/mesh.hpp"
 #include "geometry/morphology.hpp"
 #include "planner/plan_report.hpp"
@@ -56,11 +56,11 @@ struct ActionFigures {
 std::vector<ActionFigures> replay_plan(int rank) {
   const Planned& p = planned();
   const planner::PlanFilePlan& plan = p.file.plans[std::size_t(rank - 1)];
-  const gcode::PlanExport exported = gcode::export_plan(p.file, plan, p.machine);
+  const toolpaths::PlanExport exported = toolpaths::export_plan(p.file, plan, p.machine);
   const Solid core = geometry::erode(p.file.design, geometry::Ball{p.file.tolerance});
   const double h = p.file.lattice.voxel_size;
   std::vector<ActionFigures> out;
-  for (const gcode::ExportedAction& a : exported.actions) {
+  for (const toolpaths::ExportedAction& a : exported.actions) {
     if (!a.makes_gcode) continue;
     const std::string text = gcode::write_action(a.program, p.machine);
     ReplayOptions options;
@@ -142,7 +142,7 @@ TEST(PlanReplay, TheWholeProgramChangesToolsBeforeStartingThem) {
     for (const auto& a : p.file.plans[k].actions)
       if (p.file.primitives[std::size_t(a.primitive)].mode == planner::Mode::Subtractive) rank = int(k) + 1;
   ASSERT_GT(rank, 0);
-  const gcode::PlanExport exported = gcode::export_plan(p.file, p.file.plans[std::size_t(rank - 1)], p.machine);
+  const toolpaths::PlanExport exported = toolpaths::export_plan(p.file, p.file.plans[std::size_t(rank - 1)], p.machine);
   const std::string text = gcode::write_program(exported.programs(), p.machine);
   gcode::Interpreter interp(p.machine, "plan.ngc");
   int line = 0, tool = 0, spindle_starts = 0, depositions = 0;

@@ -7,7 +7,7 @@
 #include <chrono>
 #include <random>
 
-#include "drivers/protocol/modbus_map.hpp"
+#include "protocol/modbus_map.hpp"
 #include "sim_process.hpp"
 #include "wire_client.hpp"
 

@@ -1,4 +1,4 @@
-// The simulated controller as a CAN node (sim/can_node.hpp), in process: when it puts a
+// The simulated controller as a CAN node (sim/wire/can_node.hpp), in process: when it puts a
 // status snapshot on the bus. Besides the periodic one, a host waiting on the controller
 // hears at once when the state or alarm changes and when a full buffer has room for a
 // chunk again, instead of a status period later.
@@ -8,10 +8,10 @@
 #include <chrono>
 
 #include "config/machine_loader.hpp"
-#include "drivers/protocol/can_frames.hpp"
-#include "drivers/protocol/can_transfer.hpp"
-#include "drivers/protocol/chunk.hpp"
-#include "sim/can_node.hpp"
+#include "protocol/can_frames.hpp"
+#include "protocol/can_transfer.hpp"
+#include "protocol/chunk.hpp"
+#include "sim/wire/can_node.hpp"
 #include "sim/controller.hpp"
 
 namespace hybridctl::sim {

@@ -1,11 +1,11 @@
-// The simulator's fault schedule (sim/fault_injection.hpp): periodic by default, random
+// The simulator's fault schedule (sim/wire/fault_injection.hpp): periodic by default, random
 // from a seed for soak runs, and the same faults every time for the same seed.
 
 #include <gtest/gtest.h>
 
 #include <vector>
 
-#include "sim/fault_injection.hpp"
+#include "sim/wire/fault_injection.hpp"
 
 namespace hybridctl::sim {
 namespace {

@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
-#include "drivers/protocol/modbus_map.hpp"
+#include "protocol/modbus_map.hpp"
 #include "geometry/vdb_file.hpp"
 #include "sim_process.hpp"
 #include "wire_client.hpp"

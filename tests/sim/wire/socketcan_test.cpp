@@ -16,8 +16,8 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include "drivers/protocol/can_frames.hpp"
-#include "sim/socketcan_endpoint.hpp"
+#include "protocol/can_frames.hpp"
+#include "sim/wire/socketcan_endpoint.hpp"
 #include "sim_process.hpp"
 
 namespace hybridctl::test {

@@ -9,9 +9,9 @@
 #include <regex>
 #include <sstream>
 
-#include "drivers/protocol/can_frames.hpp"
-#include "sim/can_node.hpp"
-#include "sim/socketcand_server.hpp"
+#include "protocol/can_frames.hpp"
+#include "sim/wire/can_node.hpp"
+#include "sim/wire/socketcand_server.hpp"
 #include "sim_process.hpp"
 #include "wire_client.hpp"
 

@@ -9,7 +9,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include "drivers/protocol/modbus_map.hpp"
+#include "protocol/modbus_map.hpp"
 
 namespace hybridctl::test {
 

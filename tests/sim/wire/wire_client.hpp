@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "drivers/protocol/chunk.hpp"
-#include "drivers/protocol/messages.hpp"
+#include "protocol/chunk.hpp"
+#include "protocol/messages.hpp"
 
 namespace hybridctl::test {
 

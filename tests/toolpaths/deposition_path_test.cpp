@@ -1,0 +1,403 @@
+// Raster deposition, as a specification: what a deposition toolpath must and must not do.
+// The checks read the moves back (no knowledge of the generator's insides): every
+// deposition segment lies in the ROI slice of its layer, layers go bottom-up with the
+// raster turning between them, travel never descends into material, and deposit with
+// nothing below it is reported.
+
+#include "toolpaths/deposition_path.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <set>
+
+#include "toolpaths/setup_frame.hpp"
+#include "geometry/shapes.hpp"
+#include "toolpath_oracles.hpp"
+
+namespace hybridctl::toolpaths {
+namespace {
+
+using geometry::Box3;
+using geometry::Index3;
+using geometry::Lattice;
+using geometry::make_box;
+using geometry::Solid;
+using geometry::Vec3;
+using testing::along;
+using testing::move_starts;
+
+const Lattice kLattice{0.5, {0, 0, 0}};
+
+config::AdditiveHead ded_head() {
+  config::AdditiveHead h;
+  h.name = "ded";
+  h.bead = {config::BeadShape::Ellipsoid, 1.5, 0.75};
+  h.layer_height = 0.6;
+  h.hatch_spacing = 1.05;
+  h.travel_clearance = 5;
+  h.feed = 800;
+  return h;
+}
+
+config::Setup top_setup() {
+  config::Setup s;
+  s.name = "top";
+  s.approach = config::Approach::PlusZ;
+  return s;
+}
+
+Solid box(Box3 b) { return make_box(kLattice, b); }
+
+// The ROI voxel layers a deposition layer at height z_bottom stands for: those whose
+// centres lie in its band [z_bottom, z_bottom + layer_height).
+std::vector<int> layer_slices(double z_bottom, double layer_height) {
+  const double h = kLattice.voxel_size;
+  std::vector<int> out;
+  for (int k = int(std::floor(z_bottom / h)) - 1; (k + 0.5) * h < z_bottom + layer_height - 1e-9; ++k)
+    if ((k + 0.5) * h >= z_bottom - 1e-9) out.push_back(k);
+  if (out.empty()) out.push_back(int(std::floor((z_bottom + layer_height / 2) / h)));
+  return out;
+}
+
+// Within half a voxel (sideways) of a voxel of `solid` in one of the layers `ks`.
+bool near_slice(const Solid& solid, Vec3 p, const std::vector<int>& ks) {
+  const double h = kLattice.voxel_size;
+  for (int k : ks)
+    for (double dx : {-h / 2, 0.0, h / 2})
+      for (double dy : {-h / 2, 0.0, h / 2})
+        if (solid.contains({int(std::floor((p.x + dx) / h)), int(std::floor((p.y + dy) / h)), k})) return true;
+  return false;
+}
+
+struct Segment {
+  Vec3 a, b;
+};
+std::vector<Segment> deposition_segments(const Toolpath& p) {
+  std::vector<Segment> out;
+  const auto starts = move_starts(p);
+  for (std::size_t i = 0; i < p.moves.size(); ++i)
+    if (p.moves[i].process_on) out.push_back({starts[i], p.moves[i].to});
+  return out;
+}
+
+void expect_segments_in_region(const Toolpath& p, const Solid& roi, double layer_height) {
+  const auto segments = deposition_segments(p);
+  ASSERT_FALSE(segments.empty());
+  int outside = 0;
+  for (const Segment& s : segments) {
+    ASSERT_DOUBLE_EQ(s.a.z, s.b.z) << "deposition moves are level";
+    const std::vector<int> ks = layer_slices(s.a.z, layer_height);
+    along(s.a, s.b, kLattice.voxel_size / 8, [&](Vec3 q) {
+      if (!near_slice(roi, q, ks) && ++outside <= 5)
+        ADD_FAILURE() << "deposit at (" << q.x << ", " << q.y << ", " << q.z << ") is outside the ROI layers "
+                      << ks.front() << ".." << ks.back();
+    });
+  }
+  EXPECT_EQ(outside, 0);
+}
+
+bool has_warning(const Toolpath& p, const std::string& word) {
+  for (const auto& w : p.warnings)
+    if (w.find(word) != std::string::npos) return true;
+  return false;
+}
+
+TEST(DepositionPath, RecordsTheHeadSetupAndFeeds) {
+  const Solid roi = box({{2, 2, 0}, {8, 6, 2}});
+  DepositionOptions o;
+  o.fallback_tool_number = 101;
+  const Toolpath p = deposition_path(roi, Solid(kLattice, {}), ded_head(), top_setup(), o);
+  EXPECT_EQ(p.process, Process::Deposition);
+  EXPECT_EQ(p.instrument, "ded");
+  EXPECT_EQ(p.setup, "top");
+  EXPECT_EQ(p.tool_number, 101) << "a head without a tool number takes the fallback";
+  auto numbered = ded_head();
+  numbered.tool_number = 105;
+  EXPECT_EQ(deposition_path(roi, Solid(kLattice, {}), numbered, top_setup(), o).tool_number, 105);
+  ASSERT_FALSE(p.moves.empty());
+  EXPECT_EQ(p.moves.front().kind, MoveKind::Rapid);
+  EXPECT_EQ(p.moves.front().to, p.start);
+  EXPECT_DOUBLE_EQ(p.start.z, p.safe_z);
+  for (const auto& m : p.moves) {
+    if (m.process_on) {
+      EXPECT_EQ(m.kind, MoveKind::Feed);
+      EXPECT_DOUBLE_EQ(m.feed, 800);
+    }
+    EXPECT_LE(m.to.z, p.safe_z + 1e-9);
+  }
+  EXPECT_DOUBLE_EQ(p.moves.back().to.z, p.safe_z);
+}
+
+TEST(DepositionPath, SegmentsLieInTheirLayersRegion) {
+  // An L-shaped wall on a base plate, with a hole: rasters must break at the hole.
+  const Solid base = box({{0, 0, 0}, {20, 16, 2}});
+  Solid roi = geometry::unite(box({{1, 1, 2}, {19, 5, 6}}), box({{1, 1, 2}, {6, 15, 4.5}}));
+  roi = geometry::subtract(roi, box({{9, 2, 2}, {12, 4, 6}}));
+  const auto head = ded_head();
+  const Toolpath p = deposition_path(roi, base, head, top_setup());
+  expect_segments_in_region(p, roi, head.layer_height);
+  EXPECT_FALSE(has_warning(p, "overhang"));
+}
+
+TEST(DepositionPath, ContourPassesStayInTheRegionToo) {
+  const Solid roi = make_box(kLattice, {{2, 2, 0}, {14, 10, 1.8}});
+  const auto head = ded_head();
+  DepositionOptions o;
+  o.contour = ContourPass::BeforeInfill;
+  const Toolpath with = deposition_path(roi, Solid(kLattice, {}), head, top_setup(), o);
+  const Toolpath without = deposition_path(roi, Solid(kLattice, {}), head, top_setup());
+  expect_segments_in_region(with, roi, head.layer_height);
+  EXPECT_GT(deposition_segments(with).size(), deposition_segments(without).size());
+  // The contour comes first in a layer: the first deposition moves turn corners.
+  const auto segs = deposition_segments(with);
+  std::set<std::pair<int, int>> directions;
+  for (std::size_t i = 0; i < 4 && i < segs.size(); ++i)
+    directions.insert({int(std::round(segs[i].b.x - segs[i].a.x > 0 ? 1 : segs[i].b.x < segs[i].a.x ? -1 : 0)),
+                       int(std::round(segs[i].b.y - segs[i].a.y > 0 ? 1 : segs[i].b.y < segs[i].a.y ? -1 : 0))});
+  EXPECT_GE(directions.size(), 3u);
+}
+
+TEST(DepositionPath, LayersGoBottomUpAtTheLayerHeight) {
+  const Solid base = box({{0, 0, 0}, {12, 12, 1}});
+  const Solid roi = box({{2, 2, 1}, {10, 10, 5}});
+  const auto head = ded_head();
+  const Toolpath p = deposition_path(roi, base, head, top_setup());
+  std::vector<double> layer_z;
+  double last = -1e9;
+  for (const auto& s : deposition_segments(p)) {
+    EXPECT_GE(s.a.z, last - 1e-9) << "a layer below one already deposited";
+    if (s.a.z > last + 1e-9) layer_z.push_back(s.a.z);
+    last = s.a.z;
+  }
+  ASSERT_GE(layer_z.size(), 6u);
+  EXPECT_NEAR(layer_z.front(), 1.0, 1e-9) << "the first layer lies on the ROI's bottom face";
+  for (std::size_t i = 1; i < layer_z.size(); ++i) EXPECT_NEAR(layer_z[i] - layer_z[i - 1], head.layer_height, 1e-9);
+  // 4 mm of ROI at 0.6 mm layers: the layer whose middle is still inside is the last.
+  EXPECT_NEAR(layer_z.back(), 1.0 + 6 * 0.6, 1e-9);
+}
+
+TEST(DepositionPath, EveryVoxelLayerOfTheRoiBelongsToADepositionLayer) {
+  // 0.6 mm layers on 0.5 mm voxels: the band [1.2, 1.8) holds the centres of voxel layers
+  // 2 and 3. A flange one voxel thick in layer 2 (z 1.0..1.5) must be deposited with that
+  // band, not lost between the voxel layers the bands' middles fall in.
+  const Solid roi = geometry::unite(box({{4, 4, 0}, {12, 12, 2}}), box({{0, 0, 1}, {16, 16, 1.5}}));
+  const auto head = ded_head();
+  const Toolpath p = deposition_path(roi, Solid(kLattice, {}), head, top_setup());
+  expect_segments_in_region(p, roi, head.layer_height);
+  double flange = 0;  // mm of deposition outside the core's footprint
+  for (const auto& s : deposition_segments(p))
+    along(s.a, s.b, 0.05, [&](Vec3 q) {
+      if (q.x < 3.5 || q.x > 12.5 || q.y < 3.5 || q.y > 12.5) flange += 0.05;
+    });
+  EXPECT_GT(flange, 50);
+}
+
+double direction_deg(const Segment& s) {
+  double a = std::atan2(s.b.y - s.a.y, s.b.x - s.a.x) * 180 / std::numbers::pi;
+  while (a < 0) a += 180;
+  while (a >= 180) a -= 180;
+  return a;
+}
+
+TEST(DepositionPath, RasterDirectionAlternatesBetweenLayers) {
+  const Solid roi = box({{0, 0, 0}, {10, 8, 3}});
+  const Toolpath p = deposition_path(roi, Solid(kLattice, {}), ded_head(), top_setup());
+  std::map<double, std::set<int>> by_layer;
+  for (const auto& s : deposition_segments(p)) by_layer[s.a.z].insert(int(std::lround(direction_deg(s))) % 180);
+  ASSERT_GE(by_layer.size(), 4u);
+  int previous = -1;
+  for (const auto& [z, dirs] : by_layer) {
+    ASSERT_EQ(dirs.size(), 1u) << "one raster direction per layer at z=" << z;
+    const int d = *dirs.begin();
+    EXPECT_TRUE(d == 0 || d == 90);
+    if (previous >= 0) {
+      EXPECT_NE(d, previous) << "layer at z=" << z << " repeats the previous direction";
+    }
+    previous = d;
+  }
+}
+
+TEST(DepositionPath, ArbitraryRasterAnglesFollowTheOptions) {
+  const Solid roi = geometry::make_cylinder(kLattice, geometry::Axis::Z, {10, 10, 0}, 7, 2.4);
+  const auto head = ded_head();
+  DepositionOptions o;
+  o.raster_angles_deg = {30, 120, 210};
+  const Toolpath p = deposition_path(roi, Solid(kLattice, {}), head, top_setup(), o);
+  expect_segments_in_region(p, roi, head.layer_height);
+  std::map<double, std::set<int>> by_layer;
+  for (const auto& s : deposition_segments(p)) by_layer[s.a.z].insert(int(std::lround(direction_deg(s))));
+  ASSERT_EQ(by_layer.size(), 4u);
+  const int expected[] = {30, 120, 30, 30};  // 210 runs along 30
+  int i = 0;
+  for (const auto& [z, dirs] : by_layer) {
+    EXPECT_EQ(dirs, std::set<int>{expected[i]}) << "layer " << i;
+    ++i;
+  }
+  // Parallel lines at the hatch spacing: neighbouring 30-degree lines of the first layer.
+  std::set<long> offsets;
+  const double nx = -std::sin(30 * std::numbers::pi / 180), ny = std::cos(30 * std::numbers::pi / 180);
+  for (const auto& s : deposition_segments(p))
+    if (std::abs(s.a.z - by_layer.begin()->first) < 1e-9) offsets.insert(std::lround((s.a.x * nx + s.a.y * ny) * 1000));
+  ASSERT_GE(offsets.size(), 10u);
+  for (auto it = std::next(offsets.begin()); it != offsets.end(); ++it)
+    EXPECT_NEAR((*it - *std::prev(it)) / 1000.0, head.hatch_spacing, 2e-3);
+}
+
+// The surface under (x, y) before a move: existing voxels and the layers deposited so
+// far (layer_height each, on the columns of their region).
+TEST(DepositionPath, NoRapidDescendsIntoMaterial) {
+  // Two pads on either side of a tall existing wall, on a stepped base; 0.45 mm layers
+  // put layer bottoms just under some voxel faces, where the bead is laid into the
+  // existing surface and the head must come down the last bit at feed.
+  const Solid base = geometry::unite(box({{0, 0, 0}, {30, 12, 1}}), box({{0, 0, 1}, {6, 12, 2}}));
+  const Solid wall = box({{13, 0, 1}, {16, 12, 12}});
+  const Solid existing = geometry::unite(base, wall);
+  const Solid roi = geometry::unite(geometry::subtract(box({{1, 1, 1}, {11, 11, 3}}), existing), box({{18, 1, 1}, {28, 11, 2.5}}));
+  auto head = ded_head();
+  head.layer_height = 0.45;
+  const Toolpath p = deposition_path(roi, existing, head, top_setup());
+  expect_segments_in_region(p, roi, head.layer_height);
+
+  const double h = kLattice.voxel_size;
+  std::map<std::pair<int, int>, double> deposited;  // column -> top of deposit so far
+  auto inside_material = [&](Vec3 q) {
+    const int x = int(std::floor(q.x / h)), y = int(std::floor(q.y / h)), z = int(std::floor(q.z / h));
+    if (existing.contains({x, y, z})) return true;
+    auto it = deposited.find({x, y});
+    return it != deposited.end() && q.z < it->second - 1e-9;
+  };
+  const auto starts = move_starts(p);
+  int descents = 0, feed_descents = 0, crossed_wall = 0;
+  double current_layer = -1;
+  std::set<std::pair<int, int>> layer_columns;
+  for (std::size_t i = 0; i < p.moves.size(); ++i) {
+    const auto& m = p.moves[i];
+    const Vec3 a = starts[i], b = m.to;
+    if (m.process_on && std::abs(b.z - current_layer) > 1e-9) {
+      // A new layer: the previous one is down.
+      for (auto c : layer_columns) deposited[c] = current_layer + head.layer_height;
+      layer_columns.clear();
+      current_layer = b.z;
+    }
+    if (m.process_on)
+      along(a, b, h / 8, [&](Vec3 q) { layer_columns.insert({int(std::floor(q.x / h)), int(std::floor(q.y / h))}); });
+    if (m.kind == MoveKind::Rapid) {
+      along(a, b, h / 8, [&](Vec3 q) {
+        EXPECT_FALSE(inside_material(q)) << "rapid " << i << " passes through material at (" << q.x << ", " << q.y
+                                         << ", " << q.z << ")";
+      });
+      if (b.z < a.z) ++descents;
+      // Travel across the wall clears it by the travel clearance.
+      if ((a.x < 13 && b.x > 16) || (a.x > 16 && b.x < 13)) {
+        ++crossed_wall;
+        EXPECT_GE(std::min(a.z, b.z), 12 + head.travel_clearance - 1e-9);
+      }
+    }
+    if (m.kind == MoveKind::Feed && !m.process_on && b.z < a.z) ++feed_descents;
+  }
+  EXPECT_GT(descents, 10);
+  EXPECT_GT(feed_descents, 0) << "some layer bottoms lie under the stepped base's surface";
+  EXPECT_GT(crossed_wall, 0);
+}
+
+TEST(DepositionPath, TravelLiftsByTheClearanceOverWhatIsBelow) {
+  const Solid roi = box({{0, 0, 0}, {10, 10, 1.2}});
+  const auto head = ded_head();
+  const Toolpath p = deposition_path(roi, Solid(kLattice, {}), head, top_setup());
+  const auto starts = move_starts(p);
+  int lifts = 0;
+  for (std::size_t i = 1; i < p.moves.size(); ++i) {
+    const auto& m = p.moves[i];
+    if (m.kind == MoveKind::Rapid && m.to.z > starts[i].z && m.to.z < p.safe_z - 1e-9) {
+      ++lifts;
+      // Over the deposit of the layer being laid (up to its bead height) plus clearance.
+      double next_layer = 0;
+      for (std::size_t j = i; j < p.moves.size(); ++j)
+        if (p.moves[j].process_on) {
+          next_layer = p.moves[j].to.z;
+          break;
+        }
+      EXPECT_NEAR(m.to.z, next_layer + head.bead.height + head.travel_clearance, 1e-9);
+    }
+  }
+  EXPECT_GT(lifts, 5);
+}
+
+TEST(DepositionPath, OverhangsAreReported) {
+  const auto head = ded_head();
+  // A block on the plate (the lowest material) is supported; so is one on existing
+  // material; a block in mid-air beside them is not.
+  const Solid base = box({{0, 0, 0}, {10, 10, 3}});
+  const Solid on_plate = box({{0, 0, 0}, {6, 6, 3}});
+  const Toolpath p1 = deposition_path(on_plate, Solid(kLattice, {}), head, top_setup());
+  EXPECT_FALSE(has_warning(p1, "overhang")) << (p1.warnings.empty() ? "" : p1.warnings.front());
+  const Toolpath p2 = deposition_path(box({{2, 2, 3}, {8, 8, 6}}), base, head, top_setup());
+  EXPECT_FALSE(has_warning(p2, "overhang")) << (p2.warnings.empty() ? "" : p2.warnings.front());
+  const Toolpath p3 = deposition_path(box({{14, 2, 5}, {20, 8, 7}}), base, head, top_setup());
+  ASSERT_TRUE(has_warning(p3, "overhang"));
+  // Only the first layer floats: later ones sit on it.
+  int overhang_warnings = 0;
+  for (const auto& w : p3.warnings) overhang_warnings += w.find("overhang") != std::string::npos;
+  EXPECT_EQ(overhang_warnings, 1);
+  // An explicit build plate below a floating block.
+  DepositionOptions o;
+  o.build_plate_z = 0;
+  const Toolpath p4 = deposition_path(box({{2, 2, 4}, {8, 8, 6}}), Solid(kLattice, {}), head, top_setup(), o);
+  EXPECT_TRUE(has_warning(p4, "overhang"));
+  o.build_plate_z = 4;
+  const Toolpath p5 = deposition_path(box({{2, 2, 4}, {8, 8, 6}}), Solid(kLattice, {}), head, top_setup(), o);
+  EXPECT_FALSE(has_warning(p5, "overhang"));
+  // A ledge wider than its support by more than half a bead overhangs at its edge.
+  const Toolpath p6 = deposition_path(box({{0, 0, 3}, {14, 10, 5}}), base, head, top_setup());
+  EXPECT_TRUE(has_warning(p6, "overhang"));
+}
+
+TEST(DepositionPath, RegionsNarrowerThanABeadAreDroppedWithAWarning) {
+  const Solid roi = box({{0, 0, 0}, {10, 0.5, 1}});  // one voxel wide: shorter than a bead across
+  DepositionOptions o;
+  o.raster_angles_deg = {90};
+  const Toolpath p = deposition_path(roi, Solid(kLattice, {}), ded_head(), top_setup(), o);
+  EXPECT_TRUE(deposition_segments(p).empty());
+  EXPECT_TRUE(has_warning(p, "dropped"));
+  const Toolpath empty = deposition_path(Solid(kLattice, {}), Solid(kLattice, {}), ded_head(), top_setup());
+  EXPECT_TRUE(empty.moves.empty());
+  EXPECT_FALSE(empty.warnings.empty());
+}
+
+TEST(DepositionPath, RoiUnderExistingMaterialIsSkipped) {
+  // A bridge of existing material over part of the ROI: out of reach from +Z.
+  const Solid existing = geometry::unite(box({{0, 0, 0}, {20, 10, 1}}), box({{8, 0, 4}, {12, 10, 5}}));
+  const Solid roi = box({{2, 2, 1}, {18, 8, 3}});
+  const auto head = ded_head();
+  const Toolpath p = deposition_path(roi, existing, head, top_setup());
+  EXPECT_TRUE(has_warning(p, "under existing material"));
+  for (const auto& s : deposition_segments(p))
+    along(s.a, s.b, 0.05, [&](Vec3 q) { EXPECT_FALSE(q.x > 8.01 && q.x < 11.99) << q.x; });
+}
+
+TEST(DepositionPath, OtherSetupsWorkInTheirWorkFrame) {
+  // Deposit from below (approach -Z): in the part frame the layers grow downwards.
+  const Solid existing = box({{0, 0, 5}, {10, 10, 8}});
+  const Solid roi = box({{2, 2, 2}, {8, 8, 5}});
+  config::Setup bottom;
+  bottom.name = "bottom";
+  bottom.approach = config::Approach::MinusZ;
+  const auto head = ded_head();
+  const Toolpath p = deposition_path(roi, existing, head, bottom);
+  EXPECT_EQ(p.setup, "bottom");
+  expect_segments_in_region(p, part_to_work(roi, bottom.approach), head.layer_height);
+  EXPECT_FALSE(has_warning(p, "overhang"));
+  double previous = 1e9;
+  for (const auto& s : deposition_segments(p)) {
+    const Vec3 q = work_to_part(s.a, bottom.approach);
+    EXPECT_LE(q.z, previous + 1e-9) << "part-frame layers go down from the existing block";
+    previous = q.z;
+    EXPECT_TRUE(roi.contains({int(std::floor(q.x / 0.5)), int(std::floor(q.y / 0.5)), int(std::floor((q.z - 0.3) / 0.5))}));
+  }
+}
+
+}  // namespace
+}  // namespace hybridctl::toolpaths

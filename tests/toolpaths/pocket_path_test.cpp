@@ -1,0 +1,414 @@
+// Pocket milling, as a specification. The checks replay the moves against independent
+// oracles (toolpath_oracles.hpp): the tool is the planner's continuous body of revolution
+// (planner::tool_instrument: cutter, shank, holder), followed at 1/8-voxel steps.
+//   - never gouge: no position of any feed move (cuts, links, ramps, plunges) or rapid
+//     puts any part of the tool into a voxel of `keep`;
+//   - rapids never meet material still there (replayed removal);
+//   - plunges only in air; elsewhere ramps no steeper than the ramp angle;
+//   - the pocket is cleared: the cutter swept along the moves covers every ROI voxel
+//     some allowed tool position could reach (the round tool's corners stay);
+//   - levels include every floor; disconnected islands are joined by retracts.
+
+#include "toolpaths/pocket_path.hpp"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <set>
+
+#include "toolpaths/setup_frame.hpp"
+#include "geometry/morphology.hpp"
+#include "geometry/shapes.hpp"
+#include "planner/machine_primitives.hpp"
+#include "toolpath_oracles.hpp"
+
+namespace hybridctl::toolpaths {
+namespace {
+
+using geometry::Box3;
+using geometry::Index3;
+using geometry::IndexBox;
+using geometry::Lattice;
+using geometry::make_box;
+using geometry::Solid;
+using geometry::Vec3;
+using testing::along;
+using testing::Columns;
+using testing::move_starts;
+using testing::ToolProfile;
+
+const Lattice kLattice{0.5, {0, 0, 0}};
+
+config::CuttingTool flat_4mm() {
+  config::CuttingTool t;
+  t.number = 7;
+  t.name = "4 mm flat";
+  t.type = config::ToolType::Flat;
+  t.diameter = 4;
+  t.flute_length = 8;
+  t.shank = {4, 8};
+  t.holder = {12, 20};
+  t.feed = 900;
+  t.plunge_feed = 250;
+  t.step_down = 2;
+  t.step_over = 1.5;
+  return t;
+}
+
+config::Setup top_setup() {
+  config::Setup s;
+  s.name = "top";
+  s.approach = config::Approach::PlusZ;
+  return s;
+}
+
+Solid box(Box3 b) { return make_box(kLattice, b); }
+
+struct Replay {
+  int feed_moves = 0, gouges = 0, rapids_into_material = 0, plunges = 0, plunges_into_material = 0, ramps = 0;
+  double steepest_ramp_deg = 0;
+  Solid present;  // what is left after the moves
+};
+
+// Replays the moves in order on `stock`: the cutter removes what it sweeps along feed
+// moves; rapids and plunges are checked against what is there at that moment, every
+// position against `keep`. Everything in the work frame.
+Replay replay(const Toolpath& p, const Solid& stock, const Solid& keep, const config::CuttingTool& tool) {
+  const auto instrument = planner::tool_instrument(tool, config::Approach::PlusZ);
+  std::vector<geometry::StructuringElement> whole = instrument.cutting;
+  whole.insert(whole.end(), instrument.body.begin(), instrument.body.end());
+  const ToolProfile tool_all = ToolProfile::from(whole), cutter = ToolProfile::from(instrument.cutting);
+  const Columns keep_columns(keep);
+  testing::Stock material(stock, cutter);
+  Replay r;
+  const double h = kLattice.voxel_size;
+  const auto starts = move_starts(p);
+  for (std::size_t i = 0; i < p.moves.size(); ++i) {
+    const auto& m = p.moves[i];
+    const Vec3 a = starts[i], b = m.to;
+    along(a, b, h / 8, [&](Vec3 q) {
+      Index3 where;
+      if (testing::tool_touches(tool_all, keep_columns, q, &where) && ++r.gouges <= 5)
+        ADD_FAILURE() << "move " << i << (m.kind == MoveKind::Rapid ? " (rapid)" : " (feed)") << " at (" << q.x << ", "
+                      << q.y << ", " << q.z << ") touches keep voxel (" << where.x << ", " << where.y << ", " << where.z
+                      << ")";
+    });
+    const bool vertical_down = a.x == b.x && a.y == b.y && b.z < a.z;
+    if (m.kind == MoveKind::Rapid || (m.kind == MoveKind::Feed && vertical_down)) {
+      // Rapids and plunges must meet nothing at all.
+      const Columns now(material.present());
+      bool hit = false;
+      along(a, b, h / 8, [&](Vec3 q) { hit = hit || testing::tool_touches(tool_all, now, q); });
+      if (m.kind == MoveKind::Rapid && hit && ++r.rapids_into_material <= 5)
+        ADD_FAILURE() << "rapid " << i << " to (" << b.x << ", " << b.y << ", " << b.z << ") meets material";
+      if (m.kind == MoveKind::Feed) {
+        ++r.plunges;
+        if (hit) ++r.plunges_into_material;
+      }
+    }
+    if (m.kind == MoveKind::Feed) {
+      ++r.feed_moves;
+      EXPECT_GT(m.feed, 0);
+      const double run = std::hypot(b.x - a.x, b.y - a.y);
+      if (b.z < a.z - 1e-9 && run > 1e-9) {
+        ++r.ramps;
+        r.steepest_ramp_deg = std::max(r.steepest_ramp_deg, std::atan((a.z - b.z) / run) * 180 / M_PI);
+        EXPECT_DOUBLE_EQ(m.feed, tool.plunge_feed) << "ramps at the plunge feed";
+      }
+      material.cut_along(a, b);
+    }
+  }
+  r.present = material.present();
+  return r;
+}
+
+// The ROI voxels some allowed tool position reaches, by morphology on the planner's
+// exact instrument: tips where the whole tool misses `keep`, grown by the cutter.
+Solid reachable(const Solid& roi, const Solid& keep, const config::CuttingTool& tool) {
+  const auto instrument = planner::tool_instrument(tool, config::Approach::PlusZ);
+  IndexBox domain = roi.bounding_box();
+  const int m = int(std::ceil(tool.diameter / kLattice.voxel_size)) + 2;
+  domain = {{domain.lo.x - m, domain.lo.y - m, domain.lo.z}, {domain.hi.x + m, domain.hi.y + m, domain.hi.z + 40}};
+  Solid forbidden(kLattice, domain);
+  for (const auto& e : instrument.cutting) forbidden = geometry::unite(forbidden, geometry::dilate(keep, geometry::reflected(e), domain));
+  for (const auto& e : instrument.body) forbidden = geometry::unite(forbidden, geometry::dilate(keep, geometry::reflected(e), domain));
+  const Solid allowed = geometry::complement(forbidden, domain);
+  Solid swept(kLattice, domain);
+  for (const auto& e : instrument.cutting) swept = geometry::unite(swept, geometry::dilate(allowed, e, domain));
+  return geometry::intersect(roi, swept);
+}
+
+std::set<long> feed_levels(const Toolpath& p) {
+  std::set<long> z;
+  const auto starts = move_starts(p);
+  for (std::size_t i = 0; i < p.moves.size(); ++i)
+    if (p.moves[i].kind == MoveKind::Feed && starts[i].z == p.moves[i].to.z) z.insert(std::lround(p.moves[i].to.z * 1000));
+  return z;
+}
+
+double centre_z(int k) { return kLattice.origin.z + (k + 0.5) * kLattice.voxel_size; }
+
+// A block with a closed rectangular pocket, 16 x 14 mm, 5 mm deep.
+struct ClosedPocket {
+  Solid stock = box({{0, 0, 0}, {24, 22, 8}});
+  Solid roi = box({{4, 4, 3}, {20, 18, 8}});
+  Solid keep = geometry::subtract(stock, roi);
+};
+
+TEST(PocketPath, RecordsTheToolSetupAndSafeHeight) {
+  const ClosedPocket c;
+  const Toolpath p = pocket_path(c.roi, c.keep, c.stock, flat_4mm(), top_setup());
+  EXPECT_EQ(p.process, Process::Milling);
+  EXPECT_EQ(p.instrument, "4 mm flat");
+  EXPECT_EQ(p.tool_number, 7);
+  EXPECT_EQ(p.setup, "top");
+  EXPECT_GE(p.safe_z, 8 + 1e-9) << "above all material";
+  ASSERT_FALSE(p.moves.empty());
+  EXPECT_EQ(p.moves.front().kind, MoveKind::Rapid);
+  EXPECT_EQ(p.moves.front().to, p.start);
+  EXPECT_DOUBLE_EQ(p.start.z, p.safe_z);
+  EXPECT_DOUBLE_EQ(p.moves.back().to.z, p.safe_z);
+  for (const auto& m : p.moves) {
+    EXPECT_LE(m.to.z, p.safe_z + 1e-9);
+    if (m.kind == MoveKind::Rapid) {
+      EXPECT_EQ(m.feed, 0);
+    } else {
+      EXPECT_TRUE(m.feed == 900 || m.feed == 250) << m.feed;
+    }
+  }
+}
+
+TEST(PocketPath, ClosedPocketIsClearedWithoutGougingAndEnteredByRamps) {
+  const ClosedPocket c;
+  const auto tool = flat_4mm();
+  const auto t0 = std::chrono::steady_clock::now();
+  const Toolpath p = pocket_path(c.roi, c.keep, c.stock, tool, top_setup());
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0);
+  const Replay r = replay(p, c.stock, c.keep, tool);
+  EXPECT_EQ(r.gouges, 0);
+  EXPECT_EQ(r.rapids_into_material, 0);
+  EXPECT_EQ(r.plunges_into_material, 0) << "a closed pocket is entered by ramping, never by plunging into material";
+  EXPECT_GT(r.ramps, 0);
+  EXPECT_LE(r.steepest_ramp_deg, 3.0 + 1e-6);
+  // Cleared: what stays of the ROI is only what no allowed tool position reaches (the
+  // four vertical corners a round tool leaves).
+  const Solid left = geometry::intersect(r.present, c.roi);
+  const Solid unreachable = geometry::subtract(c.roi, reachable(c.roi, c.keep, tool));
+  EXPECT_EQ(geometry::subtract(left, unreachable).voxel_count(), 0) << "reachable ROI left uncut";
+  EXPECT_GT(unreachable.voxel_count(), 0);
+  // A 2 mm radius in a corner leaves the 8 voxels of each layer (0.5 mm) whose centres
+  // are farther than 2 mm from every allowed tip: 4 corners x 10 layers x 8.
+  EXPECT_EQ(unreachable.voxel_count(), 4 * 10 * 8) << "only the corners are out of reach";
+  // The floor is cut at the ROI's bottom voxel layer.
+  EXPECT_TRUE(feed_levels(p).count(std::lround(centre_z(6) * 1000)));
+}
+
+TEST(PocketPath, ZigzagRowsAreAtMostAStepOverApart) {
+  const Solid stock = box({{0, 0, 0}, {30, 30, 4}});
+  const Solid roi = box({{3, 3, 2}, {27, 27, 4}});
+  const Solid keep = geometry::subtract(stock, roi);
+  const auto tool = flat_4mm();
+  PocketOptions o;
+  o.wall_pass = WallPass::None;
+  const Toolpath p = pocket_path(roi, keep, stock, tool, top_setup(), o);
+  const auto starts = move_starts(p);
+  std::set<long> rows;  // y (um) of cuts along X
+  for (std::size_t i = 0; i < p.moves.size(); ++i) {
+    const auto& m = p.moves[i];
+    if (m.kind == MoveKind::Feed && m.process_on && m.to.z == starts[i].z && m.to.y == starts[i].y &&
+        std::abs(m.to.x - starts[i].x) > tool.diameter)
+      rows.insert(std::lround(m.to.y * 1000));
+  }
+  ASSERT_GE(rows.size(), 8u);
+  // From the first row at the edge of the tool's reach (2 mm off the wall, on a voxel
+  // centre) to the last, no two neighbours more than step_over apart.
+  EXPECT_EQ(*rows.begin(), 5250);
+  EXPECT_EQ(*rows.rbegin(), 24750);
+  for (auto it = std::next(rows.begin()); it != rows.end(); ++it)
+    EXPECT_LE(*it - *std::prev(it), std::lround(tool.step_over * 1000)) << "rows at " << *std::prev(it) << " and " << *it;
+  // Rows alone clear the floor away from the walls.
+  const Replay r = replay(p, stock, keep, tool);
+  EXPECT_EQ(r.gouges, 0);
+  EXPECT_EQ(geometry::intersect(r.present, box({{5, 5, 2}, {25, 25, 4}})).voxel_count(), 0);
+}
+
+TEST(PocketPath, OpenPocketsArePlungedInAirAndLedIn) {
+  // A slot through the block's +X side: the tool can start outside the stock.
+  const Solid stock = box({{0, 0, 0}, {20, 16, 8}});
+  const Solid roi = box({{6, 5, 4}, {20, 11, 8}});
+  const Solid keep = geometry::subtract(stock, roi);
+  const auto tool = flat_4mm();
+  const Toolpath p = pocket_path(roi, keep, stock, tool, top_setup());
+  const Replay r = replay(p, stock, keep, tool);
+  EXPECT_EQ(r.gouges, 0);
+  EXPECT_EQ(r.rapids_into_material, 0);
+  EXPECT_EQ(r.plunges_into_material, 0);
+  EXPECT_GT(r.plunges, 0);
+  EXPECT_EQ(r.ramps, 0) << "every level can be entered from the open side";
+  const Solid left = geometry::intersect(r.present, roi);
+  EXPECT_EQ(geometry::subtract(left, geometry::subtract(roi, reachable(roi, keep, tool))).voxel_count(), 0);
+}
+
+TEST(PocketPath, LevelsIncludeEveryFloor) {
+  // A stepped pocket: floors at 5.0 mm and 2.5 mm, neither a multiple of the 2 mm step
+  // down from the top at 8 mm.
+  const Solid stock = box({{0, 0, 0}, {20, 16, 8}});
+  const Solid roi = geometry::unite(box({{3, 3, 5}, {17, 13, 8}}), box({{6, 5, 2.5}, {12, 11, 5}}));
+  const Solid keep = geometry::subtract(stock, roi);
+  const auto tool = flat_4mm();
+  const Toolpath p = pocket_path(roi, keep, stock, tool, top_setup());
+  const auto levels = feed_levels(p);
+  EXPECT_TRUE(levels.count(std::lround(centre_z(10) * 1000))) << "the upper floor (voxel layer 10)";
+  EXPECT_TRUE(levels.count(std::lround(centre_z(5) * 1000))) << "the lower floor (voxel layer 5)";
+  // No level cuts deeper than a step below the one before it.
+  long previous = std::lround(8000);
+  for (auto it = levels.rbegin(); it != levels.rend(); ++it) {
+    EXPECT_LE(previous - *it, 2000 + 1);
+    previous = *it;
+  }
+  const Replay r = replay(p, stock, keep, tool);
+  EXPECT_EQ(r.gouges, 0);
+  const Solid left = geometry::intersect(r.present, roi);
+  EXPECT_EQ(geometry::subtract(left, geometry::subtract(roi, reachable(roi, keep, tool))).voxel_count(), 0);
+}
+
+TEST(PocketPath, DisconnectedIslandsAreJoinedByRetracts) {
+  // Two pockets with a wall between them: no feed move may cross the wall.
+  const Solid stock = box({{0, 0, 0}, {30, 14, 6}});
+  const Solid roi = geometry::unite(box({{3, 3, 3}, {12, 11, 6}}), box({{18, 3, 3}, {27, 11, 6}}));
+  const Solid keep = geometry::subtract(stock, roi);
+  const auto tool = flat_4mm();
+  const Toolpath p = pocket_path(roi, keep, stock, tool, top_setup());
+  const auto starts = move_starts(p);
+  int crossings = 0, retracts = 0;
+  for (std::size_t i = 0; i < p.moves.size(); ++i) {
+    const auto& m = p.moves[i];
+    const bool left_a = starts[i].x < 15, left_b = m.to.x < 15;
+    if (left_a != left_b) {
+      ++crossings;
+      EXPECT_EQ(m.kind, MoveKind::Rapid) << "move " << i << " crosses the wall";
+      EXPECT_DOUBLE_EQ(m.to.z, p.safe_z);
+      EXPECT_DOUBLE_EQ(starts[i].z, p.safe_z);
+    }
+    if (m.kind == MoveKind::Rapid && m.to.z == p.safe_z && starts[i].z < p.safe_z) ++retracts;
+  }
+  EXPECT_GE(crossings, 1);
+  EXPECT_GE(retracts, 2);
+  const Replay r = replay(p, stock, keep, tool);
+  EXPECT_EQ(r.gouges, 0);
+  EXPECT_EQ(r.plunges_into_material, 0);
+  const Solid left = geometry::intersect(r.present, roi);
+  EXPECT_EQ(geometry::subtract(left, geometry::subtract(roi, reachable(roi, keep, tool))).voxel_count(), 0);
+}
+
+// A pocket around a round boss, with a ball, a bull and a flat tool whose shank is
+// narrower than its cutter: curved walls, tools that are not flat, retracts that sweep.
+TEST(PocketPath, NoToolEverTouchesWhatMustRemain) {
+  const Solid stock = box({{0, 0, 0}, {22, 22, 7}});
+  const Solid boss = geometry::make_cylinder(kLattice, geometry::Axis::Z, {11, 11, 0}, 3.2, 7);
+  const Solid roi = geometry::subtract(box({{2.5, 2.5, 2}, {19.5, 19.5, 7}}), boss);
+  const Solid keep = geometry::subtract(stock, roi);
+  config::CuttingTool ball = flat_4mm();
+  ball.type = config::ToolType::Ball;
+  ball.corner_radius = 2;
+  config::CuttingTool bull = flat_4mm();
+  bull.type = config::ToolType::Bull;
+  bull.corner_radius = 0.75;
+  config::CuttingTool necked = flat_4mm();
+  necked.shank = {3, 6};
+  for (const auto& tool : {flat_4mm(), ball, bull, necked}) {
+    SCOPED_TRACE(std::string(config::to_string(tool.type)) + " shank " + std::to_string(tool.shank.diameter));
+    const Toolpath p = pocket_path(roi, keep, stock, tool, top_setup());
+    const Replay r = replay(p, stock, keep, tool);
+    EXPECT_GT(r.feed_moves, 20);
+    EXPECT_EQ(r.gouges, 0);
+    EXPECT_EQ(r.rapids_into_material, 0);
+    EXPECT_EQ(r.plunges_into_material, 0);
+    EXPECT_LE(r.steepest_ramp_deg, 3.0 + 1e-6);
+  }
+}
+
+TEST(PocketPath, ContourParallelRingsClearToo) {
+  const Solid stock = box({{0, 0, 0}, {22, 22, 6}});
+  const Solid boss = geometry::make_cylinder(kLattice, geometry::Axis::Z, {11, 11, 0}, 3, 6);
+  const Solid roi = geometry::subtract(box({{2.5, 2.5, 3}, {19.5, 19.5, 6}}), boss);
+  const Solid keep = geometry::subtract(stock, roi);
+  const auto tool = flat_4mm();
+  PocketOptions o;
+  o.strategy = PocketStrategy::Offsets;
+  const Toolpath p = pocket_path(roi, keep, stock, tool, top_setup(), o);
+  const Replay r = replay(p, stock, keep, tool);
+  EXPECT_EQ(r.gouges, 0);
+  EXPECT_EQ(r.plunges_into_material, 0);
+  const Solid left = geometry::intersect(r.present, roi);
+  EXPECT_EQ(geometry::subtract(left, geometry::subtract(roi, reachable(roi, keep, tool))).voxel_count(), 0);
+}
+
+TEST(PocketPath, RowsAlongYAndAlternatingRowsClearToo) {
+  const ClosedPocket c;
+  const auto tool = flat_4mm();
+  for (PocketRaster raster : {PocketRaster::AlongY, PocketRaster::Alternate}) {
+    PocketOptions o;
+    o.raster = raster;
+    const Toolpath p = pocket_path(c.roi, c.keep, c.stock, tool, top_setup(), o);
+    const Replay r = replay(p, c.stock, c.keep, tool);
+    EXPECT_EQ(r.gouges, 0);
+    const Solid left = geometry::intersect(r.present, c.roi);
+    EXPECT_EQ(geometry::subtract(left, geometry::subtract(c.roi, reachable(c.roi, c.keep, tool))).voxel_count(), 0);
+  }
+}
+
+TEST(PocketPath, TheHolderKeepsTheToolOutOfDeepNarrowPlaces) {
+  // A deep pocket next to a tall wall: the 12 mm holder, 16 mm above the tip, must not
+  // hit the wall when the tip goes down next to it.
+  const Solid stock = box({{0, 0, 0}, {24, 16, 4}});
+  const Solid tower = box({{0, 0, 0}, {6, 16, 24}});
+  const Solid roi = box({{7, 3, 1}, {21, 13, 4}});
+  const Solid keep = geometry::unite(geometry::subtract(stock, roi), tower);
+  const auto tool = flat_4mm();
+  const Toolpath p = pocket_path(roi, keep, geometry::unite(stock, tower), tool, top_setup());
+  const Replay r = replay(p, geometry::unite(stock, tower), keep, tool);
+  EXPECT_GT(r.feed_moves, 10);
+  EXPECT_EQ(r.gouges, 0);
+  // Within the holder's radius of the tower the ROI stays; the warning says so.
+  bool warned = false;
+  for (const auto& w : p.warnings) warned = warned || w.find("cannot reach") != std::string::npos;
+  EXPECT_TRUE(warned);
+  EXPECT_GT(geometry::intersect(r.present, roi).voxel_count(), 0);
+}
+
+TEST(PocketPath, OtherSetupsMillInTheirWorkFrame) {
+  // A pocket in the block's +X face, milled from +X.
+  const Solid stock = box({{0, 0, 0}, {10, 16, 14}});
+  const Solid roi = box({{6, 4, 3}, {10, 12, 11}});
+  const Solid keep = geometry::subtract(stock, roi);
+  config::Setup side;
+  side.name = "side";
+  side.approach = config::Approach::PlusX;
+  const auto tool = flat_4mm();
+  const Toolpath p = pocket_path(roi, keep, stock, tool, side);
+  EXPECT_EQ(p.setup, "side");
+  const Solid stock_w = part_to_work(stock, side.approach), keep_w = part_to_work(keep, side.approach),
+              roi_w = part_to_work(roi, side.approach);
+  const Replay r = replay(p, stock_w, keep_w, tool);
+  EXPECT_EQ(r.gouges, 0);
+  EXPECT_EQ(r.plunges_into_material, 0);
+  const Solid left = geometry::intersect(r.present, roi_w);
+  EXPECT_EQ(geometry::subtract(left, geometry::subtract(roi_w, reachable(roi_w, keep_w, tool))).voxel_count(), 0);
+  // In the part frame the cutting happens inside the pocket, tool axis along +X.
+  for (const auto& m : p.moves)
+    if (m.kind == MoveKind::Feed && m.process_on) {
+      EXPECT_GE(work_to_part(m.to, side.approach).x, 6 - 1e-9);
+    }
+}
+
+TEST(PocketPath, NothingToRemoveGivesAnEmptyPathWithAWarning) {
+  const Solid stock = box({{0, 0, 0}, {10, 10, 5}});
+  const Toolpath p = pocket_path(Solid(kLattice, {}), stock, stock, flat_4mm(), top_setup());
+  EXPECT_TRUE(p.moves.empty());
+  EXPECT_FALSE(p.warnings.empty());
+}
+
+}  // namespace
+}  // namespace hybridctl::toolpaths

@@ -1,0 +1,90 @@
+#pragma once
+// Raster deposition: the toolpath that lays down an additive action's region of
+// influence (ROI) layer by layer (docs/toolpaths.md is the full description).
+//
+//   Toolpath p = deposition_path(roi, existing, head, setup);
+//
+// Work frame (toolpaths/setup_frame.hpp): the setup's approach direction is +Z. Layers of the
+// head's layer_height go bottom-up from the ROI's lowest voxel face. A layer's region is
+// the ROI's voxels whose centres lie in the layer's band [z, z + layer_height) (the
+// voxel at the band's middle when it holds no centre). Raster lines at hatch_spacing, at an
+// angle that changes from layer to layer, are clipped to the region; deposition is on
+// along the clipped segments only. Between segments the head lifts by travel_clearance
+// above the material under the travel (existing material and everything deposited so
+// far, within the nozzle's radius) and comes down again. Rapids never touch material,
+// even with the bead's volume: near the work (approach_gap above the material under the
+// bead) the head moves at feed with deposition off.
+//
+// The programmed point is the bottom of the bead on its axis: the surface the bead is
+// laid on (z = the layer's bottom).
+
+#include <optional>
+#include <vector>
+
+#include "config/machine.hpp"
+#include "gcode/toolpath.hpp"
+#include "geometry/solid.hpp"
+
+namespace hybridctl::toolpaths {
+
+// The dialect-neutral toolpath model these generators fill in (gcode/toolpath.hpp).
+using gcode::ActionProgram;
+using gcode::MoveKind;
+using gcode::PathMove;
+using gcode::Process;
+using gcode::Toolpath;
+
+// Where a layer's contour (a pass along the region's edge, half a bead inside it) goes.
+enum class ContourPass {
+  None,          // rasters only
+  BeforeInfill,  // contour first, then rasters inside it
+  AfterInfill,   // rasters inside the contour first, then the contour
+};
+
+struct DepositionOptions {
+  // Raster angle of layer i, degrees from the work frame's +X towards +Y: the list is
+  // used cyclically. The default alternates 0 and 90 degrees. Any angle is allowed.
+  std::vector<double> raster_angles_deg = {0.0, 90.0};
+  ContourPass contour = ContourPass::None;
+  // How far segment ends stay inside the region along the raster (mm), so that the
+  // bead's end does not spill out. Default: half the bead width.
+  std::optional<double> edge_inset;
+  // Clipped raster segments shorter than this (mm, before the inset) are dropped, and so
+  // are contour chains shorter than it. Default: the bead width.
+  std::optional<double> min_segment_length;
+  // The build plate, mm in the work frame: deposit lying on it is supported. Default: the
+  // bottom face of the lowest voxel of the ROI and the existing material.
+  std::optional<double> build_plate_z;
+  // Deposit is supported when material (existing, deposited, the plate) ends at most this
+  // far (mm) below the layer's bottom. Default: the layer height.
+  std::optional<double> support_gap;
+  // Deposit within this distance (mm, sideways) of supported deposit counts as supported:
+  // a bead may overhang its support by a fraction of its width. Default: half the bead
+  // width.
+  std::optional<double> overhang_reach;
+  // Rapids stop this far (mm) above the material under the bead's footprint (beads
+  // counted at their full height); the head comes down onto the surface, and leaves a
+  // bead it has just laid, at feed with deposition off.
+  double approach_gap = 0.5;
+  // The T number for a head whose tool_number is unset (0, e.g. built by hand); the
+  // machine loader always sets it (default 100 + the head's index).
+  int fallback_tool_number = 0;
+};
+
+// The head's T number: its tool_number when positive, otherwise `fallback`.
+int head_tool_number(const config::AdditiveHead& head, int fallback);
+
+// The deposition toolpath of one additive action.
+//   roi       voxels to deposit, part frame (the action's region of influence)
+//   existing  material present before the action, part frame, same lattice (may be empty)
+//   head      the additive head: bead, layer_height, hatch_spacing, travel_clearance, feed
+//   setup     the setup: its approach becomes the work frame's +Z; its name is recorded
+// Moves are in mm in the work frame. Warnings: overhangs (deposit with nothing below),
+// ROI under existing material (not reachable from the approach side: skipped), dropped
+// short segments. A layer height, hatch spacing or feed left at 0 takes the machine
+// file's default (0.8 x bead height, 0.7 x bead width, 1000 mm/min). Throws
+// std::invalid_argument on solids on different lattices or a head without a bead.
+Toolpath deposition_path(const geometry::Solid& roi, const geometry::Solid& existing, const config::AdditiveHead& head,
+                         const config::Setup& setup, const DepositionOptions& options = {});
+
+}  // namespace hybridctl::toolpaths

@@ -1,0 +1,85 @@
+#include "toolpaths/plan_export.hpp"
+
+#include "common/error.hpp"
+
+namespace hybridctl::toolpaths {
+namespace {
+
+const config::Setup& setup_named(const config::Machine& m, const planner::PlanFilePrimitive& p) {
+  for (const auto& s : m.setups)
+    if (s.name == p.setup) return s;
+  throw InputError(p.name + " (" + p.label + "): the machine '" + m.name + "' has no setup '" + p.setup +
+                   "'; expected one of its setups");
+}
+
+}  // namespace
+
+std::vector<ActionProgram> PlanExport::programs() const {
+  std::vector<ActionProgram> out;
+  for (const auto& a : actions)
+    if (a.makes_gcode) out.push_back(a.program);
+  return out;
+}
+
+PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+                       const ExportOptions& options) {
+  if (file.machine_name != machine.name)
+    throw InputError("the plan was made for machine '" + file.machine_name + "', not '" + machine.name +
+                     "'; expected the machine file it was planned with (" + file.machine_file + ")");
+  PlanExport out;
+  const std::vector<geometry::Solid> states = planner::plan_states(file, plan);
+  const int n = int(plan.actions.size());
+  for (int k = 0; k < n; ++k) {
+    if (options.progress) options.progress(k + 1, n);
+    const planner::PlanFilePrimitive& p = file.primitives[std::size_t(plan.actions[std::size_t(k)].primitive)];
+    ExportedAction a;
+    a.step = k + 1;
+    a.primitive = p.name;
+    a.before = states[std::size_t(k)];
+    a.after = states[std::size_t(k) + 1];
+    a.roi = p.mode == planner::Mode::Additive ? subtract(p.region, a.before) : intersect(a.before, p.region);
+    if (p.raw_stock()) {
+      out.raw_stock = p.label;
+      a.note = "clamp the raw stock: " + p.label;
+    } else if (a.roi.empty()) {
+      a.note = "nothing to " + std::string(p.mode == planner::Mode::Additive ? "deposit" : "remove") + " in this state";
+    } else if (p.kind == "file") {
+      throw InputError(p.name + " is a primitive from the file " + p.capability +
+                       ": no head or tool of the machine is known to make it; expected machine primitives only");
+    } else {
+      const config::Setup& setup = setup_named(machine, p);
+      ActionProgram& prog = a.program;
+      prog.action = k + 1;
+      prog.primitive = p.name;
+      prog.label = p.label;
+      prog.additive = p.mode == planner::Mode::Additive;
+      prog.volume = a.roi.volume();
+      if (prog.additive) {
+        const config::AdditiveHead* head = nullptr;
+        int index = 0;
+        for (const auto& h : machine.heads) {
+          if (h.name == p.capability) {
+            head = &h;
+            break;
+          }
+          ++index;
+        }
+        if (!head)
+          throw InputError(p.name + " (" + p.label + "): the machine has no head '" + p.capability + "'");
+        DepositionOptions d = options.deposition;
+        d.fallback_tool_number = 100 + index;
+        prog.path = deposition_path(a.roi, a.before, *head, setup, d);
+      } else {
+        const config::CuttingTool* tool = machine.find_tool(p.tool_number);
+        if (!tool)
+          throw InputError(p.name + " (" + p.label + "): the machine has no tool T" + std::to_string(p.tool_number));
+        prog.path = pocket_path(a.roi, a.after, a.before, *tool, setup, options.pocket);
+      }
+      a.makes_gcode = true;
+    }
+    out.actions.push_back(std::move(a));
+  }
+  return out;
+}
+
+}  // namespace hybridctl::toolpaths

@@ -1,0 +1,63 @@
+#pragma once
+// A plan's actions as G-code: replay the plan on the voxels, take each action's region of
+// influence in the state it meets (deposit: P minus the material there; removal: the
+// material there inside P), make its toolpath in its setup's frame, and post-process.
+//
+// The raw stock action makes no G-code: the operator clamps the stock (its name goes in
+// the program header). Actions whose region is empty in their state are skipped with a
+// note; so are none else: an action the machine cannot make (a primitive from a file, a
+// head or tool the machine lacks) is an error.
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "config/machine.hpp"
+#include "toolpaths/deposition_path.hpp"
+#include "toolpaths/pocket_path.hpp"
+#include "gcode/post.hpp"
+#include "gcode/toolpath.hpp"
+#include "planner/plan_file.hpp"
+
+namespace hybridctl::toolpaths {
+
+// The dialect-neutral toolpath model these generators fill in (gcode/toolpath.hpp).
+using gcode::ActionProgram;
+using gcode::MoveKind;
+using gcode::PathMove;
+using gcode::Process;
+using gcode::Toolpath;
+
+struct ExportOptions {
+  DepositionOptions deposition;
+  PocketOptions pocket;
+  gcode::PostOptions post;
+  // Progress: the action being made (1-based) of how many.
+  std::function<void(int action, int actions)> progress;
+};
+
+// One action of the plan with its geometry, as planned.
+struct ExportedAction {
+  int step = 0;                // 1-based in the plan
+  std::string primitive;       // P-name
+  bool makes_gcode = false;    // false for the raw stock and for empty regions
+  std::string note;            // why not, or the stock to clamp
+  geometry::Solid before;      // planned material before the action (part frame)
+  geometry::Solid after;       // planned material after it
+  geometry::Solid roi;         // its region of influence in that state
+  ActionProgram program;       // when makes_gcode
+};
+
+struct PlanExport {
+  std::string raw_stock;                 // label of the stock the plan starts from, if any
+  std::vector<ExportedAction> actions;   // every action of the plan, in order
+  std::vector<ActionProgram> programs() const;  // those that make G-code
+};
+
+// Throws hybridctl::InputError when the plan was made for another machine, or an action
+// needs an instrument or setup the machine does not have.
+PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+                       const ExportOptions& options = {});
+
+}  // namespace hybridctl::toolpaths

@@ -1,0 +1,83 @@
+#pragma once
+// Z-level pocket milling: the toolpath that removes a subtractive action's region of
+// influence (ROI) without ever touching the material that must remain
+// (docs/toolpaths.md is the full description).
+//
+//   Toolpath p = pocket_path(roi, keep, stock_before, tool, setup);
+//
+// Work frame (toolpaths/setup_frame.hpp): the tool axis is +Z. Tool positions are the tool
+// tip (the lowest point of the cutter, on its axis), always on voxel centres sideways,
+// and on voxel-centre heights at the cutting levels. Levels go top-down at the tool's
+// step_down and include every floor of the ROI. At each level the tool tip stays in the
+// allowed region: where the whole tool (cutter, shank, holder) touches no voxel of
+// `keep`, computed once in 3D by dilating `keep` with the reflected tool. The useful
+// part of a level (allowed tips whose cutter meets ROI material still there) is cleared
+// by zigzag rows at step_over plus a pass along its edge (or by contour-parallel rings),
+// linked by feed moves inside the allowed region, otherwise by retracting to safe_z.
+// Entries plunge only where the tool meets no material on the way down; elsewhere they
+// lead in sideways from air, or ramp along the first segment at ramp_angle_deg.
+
+#include <optional>
+
+#include "config/machine.hpp"
+#include "gcode/toolpath.hpp"
+#include "geometry/solid.hpp"
+
+namespace hybridctl::toolpaths {
+
+// The dialect-neutral toolpath model these generators fill in (gcode/toolpath.hpp).
+using gcode::ActionProgram;
+using gcode::MoveKind;
+using gcode::PathMove;
+using gcode::Process;
+using gcode::Toolpath;
+
+enum class PocketStrategy {
+  Zigzag,   // rows at step_over (direction per `raster`), plus an edge pass per `wall_pass`
+  Offsets,  // contour-parallel rings inward from the edge of each level's region
+};
+
+enum class PocketRaster {
+  AlongX,     // zigzag rows parallel to the work frame's X axis
+  AlongY,     // rows parallel to Y
+  Alternate,  // X on the first level, Y on the next, and so on
+};
+
+enum class WallPass {
+  None,     // rows only: material next to walls between rows may stay
+  Contour,  // after the rows, one pass along the edge of the level's useful region
+};
+
+struct PocketOptions {
+  PocketStrategy strategy = PocketStrategy::Zigzag;
+  PocketRaster raster = PocketRaster::AlongX;
+  WallPass wall_pass = WallPass::Contour;  // Zigzag only; Offsets always follow the edge
+  // Steepest descent of a ramp, degrees from the horizontal; > 0 and <= 90.
+  double ramp_angle_deg = 3.0;
+  // Rapids stop this far (mm) above the material the tool would meet at an entry.
+  double retract_clearance = 1.0;
+  // Rapids keep this much (mm) further from the plan's material, sideways and above: the
+  // stock as built is not the plan's voxels (deposition beads spill up to ~0.7 mm past
+  // them, docs/toolpaths.md), and a rapid must not meet what a feed move would shave off.
+  double material_allowance = 1.0;
+  // safe_z: this far (mm) above the highest material in the domain.
+  double safe_clearance = 5.0;
+  // Overrides of the tool's step_down and step_over (mm).
+  std::optional<double> step_down;
+  std::optional<double> step_over;
+};
+
+// The milling toolpath of one subtractive action.
+//   roi           material to remove, part frame
+//   keep          material that must remain (the state after the action): never touched
+//   stock_before  material present before the action (may be empty: then the ROI is
+//                 taken as present); material in it that is neither ROI nor `keep` is
+//                 not touched either
+//   tool          the cutting tool: diameter, type, flute, shank, holder, feeds, steps
+//   setup         its approach becomes the work frame's +Z; its name is recorded
+// All solids on one lattice (std::invalid_argument otherwise). Moves in mm, work frame.
+// Warnings: ROI the tool cannot reach (volume), entries with no room to ramp.
+Toolpath pocket_path(const geometry::Solid& roi, const geometry::Solid& keep, const geometry::Solid& stock_before,
+                     const config::CuttingTool& tool, const config::Setup& setup, const PocketOptions& options = {});
+
+}  // namespace hybridctl::toolpaths
