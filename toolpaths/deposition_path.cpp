@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "instruments/bead.hpp"
 #include "toolpaths/setup_frame.hpp"
 #include "toolpaths/slices.hpp"
 
@@ -172,10 +173,6 @@ std::vector<Pass> contour_layer(const SliceMask& region, const geometry::Lattice
 
 }  // namespace
 
-int head_tool_number(const config::AdditiveHead& head, int fallback) {
-  return head.tool_number > 0 ? head.tool_number : fallback;
-}
-
 Toolpath deposition_path(const Solid& roi_part, const Solid& existing_part, const config::AdditiveHead& head_in,
                          const config::Setup& setup, const DepositionOptions& options) {
   if (!(head_in.bead.width > 0) || !(head_in.bead.height > 0))
@@ -193,7 +190,7 @@ Toolpath deposition_path(const Solid& roi_part, const Solid& existing_part, cons
   Toolpath path;
   path.process = Process::Deposition;
   path.instrument = head.name;
-  path.tool_number = head_tool_number(head, options.fallback_tool_number);
+  path.tool_number = instruments::head_tool_number(head, options.fallback_tool_number);
   path.setup = setup.name;
 
   const Solid roi_all = part_to_work(roi_part, setup.approach);
