@@ -2,31 +2,16 @@
 
 #include <deque>
 
-#include <cmath>
-#include <limits>
-
 #include "geometry/shapes.hpp"
+#include "instruments/bead.hpp"
+#include "instruments/cutter.hpp"
+#include "instruments/elements.hpp"
 #include "planner/primitive_shapes.hpp"
 
 namespace hybridctl::planner {
 namespace {
 
-using geometry::AxialBody;
-using geometry::AxialSection;
-using geometry::AxisDirection;
 using geometry::Solid;
-
-AxisDirection direction_of(config::Approach a) {
-  switch (a) {
-    case config::Approach::PlusX: return {geometry::Axis::X, +1};
-    case config::Approach::MinusX: return {geometry::Axis::X, -1};
-    case config::Approach::PlusY: return {geometry::Axis::Y, +1};
-    case config::Approach::MinusY: return {geometry::Axis::Y, -1};
-    case config::Approach::PlusZ: return {geometry::Axis::Z, +1};
-    case config::Approach::MinusZ: return {geometry::Axis::Z, -1};
-  }
-  return {};
-}
 
 std::string setup_words(const config::Setup& s) {
   return "from " + std::string(config::to_string(s.approach)) + " (" + s.name + ")";
@@ -46,51 +31,21 @@ const char* to_string(PrimitiveKind k) {
   return "?";
 }
 
+// Deposition builds layer on layer from below the nozzle: the nozzle body constrains
+// the toolpath's clearance moves, not the depositable shape (ARCHITECTURE.md).
 Instrument bead_instrument(const config::AdditiveHead& head, config::Approach approach) {
-  const AxisDirection d = direction_of(approach);
-  const double w = head.bead.width / 2, h = head.bead.height / 2;
   Instrument in;
-  if (head.bead.shape == config::BeadShape::Ellipsoid) {
-    geometry::Vec3 radii{w, w, w};
-    (d.axis == geometry::Axis::X ? radii.x : d.axis == geometry::Axis::Y ? radii.y : radii.z) = h;
-    in.cutting.push_back(geometry::Ellipsoid{radii});
-  } else {
-    in.cutting.push_back(geometry::cylinder_body(d, w, head.bead.height));
-  }
-  // Deposition builds layer on layer from below the nozzle: the nozzle body constrains
-  // the toolpath's clearance moves, not the depositable shape (ARCHITECTURE.md).
+  in.cutting.push_back(instruments::bead_element(instruments::bead_of(head), approach));
   return in;
 }
 
+// The cutter and its body (shank, then the holder, which never ends: whatever lies in its
+// shadow is out of reach), from the tip towards the approach side.
 Instrument tool_instrument(const config::CuttingTool& tool, config::Approach approach) {
-  const AxisDirection d = direction_of(approach);
-  const double r = tool.diameter / 2, flute = tool.flute_length;
-  AxialBody cutting{d, {}};
-  switch (tool.type) {
-    case config::ToolType::Flat:
-      cutting.sections.push_back({AxialSection::Kind::Cylinder, 0, flute, r, 0, 0});
-      break;
-    case config::ToolType::Ball:
-      cutting.sections.push_back({AxialSection::Kind::Sphere, 0, r, r, r, 0});
-      cutting.sections.push_back({AxialSection::Kind::Cylinder, r, flute, r, 0, 0});
-      break;
-    case config::ToolType::Bull: {
-      const double rc = tool.corner_radius;
-      cutting.sections.push_back({AxialSection::Kind::Torus, 0, rc, rc, rc, r - rc});
-      cutting.sections.push_back({AxialSection::Kind::Cylinder, rc, flute, r, 0, 0});
-      break;
-    }
-  }
-  // Shank, then the holder; above the holder the spindle: the body never ends, so
-  // whatever lies in its shadow is out of reach.
-  const double shank_end = flute + tool.shank.length;
-  AxialBody body{d,
-                 {{AxialSection::Kind::Cylinder, flute, shank_end, tool.shank.diameter / 2, 0, 0},
-                  {AxialSection::Kind::Cylinder, shank_end, std::numeric_limits<double>::infinity(),
-                   tool.holder.diameter / 2, 0, 0}}};
+  const instruments::Cutter cutter = instruments::cutter_of(tool);
   Instrument in;
-  in.cutting.push_back(cutting);
-  in.body.push_back(body);
+  in.cutting.push_back(instruments::axial_body(cutter.cutting, approach));
+  in.body.push_back(instruments::axial_body(cutter.body, approach));
   return in;
 }
 

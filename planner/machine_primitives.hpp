@@ -31,7 +31,8 @@ struct Primitive {
 };
 
 // The structuring elements of a head's bead and of a tool's cutting part and body, in
-// the part frame of a setup (the body extends from the tip towards the approach side).
+// the part frame of a setup (the body extends from the tip towards the approach side):
+// the shapes instruments/ defines (bead_of, cutter_of), laid along the approach.
 Instrument bead_instrument(const config::AdditiveHead& head, config::Approach approach);
 Instrument tool_instrument(const config::CuttingTool& tool, config::Approach approach);
 

@@ -4,6 +4,7 @@
 
 #include "common/error.hpp"
 #include "gcode/check.hpp"
+#include "instruments/bead.hpp"
 #include "toolpaths/setup_frame.hpp"
 #include "sim/instrument.hpp"
 
@@ -60,8 +61,7 @@ struct ProgramExecutor::Impl {
   Impl(const config::Machine& m, std::string name, ExecutorOptions o, gcode::InterpreterOptions io)
       : machine(m), file_name(name), options(std::move(o)), interp(m, std::move(name), io) {
     for (const auto& t : m.tools) cutters.emplace(t.number, cutter_of(t));
-    for (std::size_t i = 0; i < m.heads.size(); ++i)
-      beads.emplace(m.heads[i].tool_number > 0 ? m.heads[i].tool_number : int(100 + i), bead_of(m.heads[i]));
+    for (std::size_t i = 0; i < m.heads.size(); ++i) beads.emplace(instruments::head_tool_number(m, i), bead_of(m.heads[i]));
     if (options.stock) {
       part_stock = *options.stock;
       domain = part_stock->storage_box();

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "instruments/bead.hpp"
 #include "toolpaths/setup_frame.hpp"
 #include "toolpaths/slices.hpp"
 
@@ -46,6 +47,7 @@ struct ColumnMap {
   int nx = 0, ny = 0;
   std::vector<double> values;
 
+  ColumnMap() = default;
   ColumnMap(const IndexBox& w, double fill)
       : window(w), nx(w.hi.x - w.lo.x), ny(w.hi.y - w.lo.y),
         values(std::size_t(std::max(nx, 0)) * std::size_t(std::max(ny, 0)), fill) {}
@@ -170,22 +172,325 @@ std::vector<Pass> contour_layer(const SliceMask& region, const geometry::Lattice
   return out;
 }
 
-}  // namespace
-
-int head_tool_number(const config::AdditiveHead& head, int fallback) {
-  return head.tool_number > 0 ? head.tool_number : fallback;
-}
-
-Toolpath deposition_path(const Solid& roi_part, const Solid& existing_part, const config::AdditiveHead& head_in,
-                         const config::Setup& setup, const DepositionOptions& options) {
+// The machine file's documented defaults for a head built by hand with them unset.
+config::AdditiveHead with_defaults(const config::AdditiveHead& head_in) {
   if (!(head_in.bead.width > 0) || !(head_in.bead.height > 0))
     throw std::invalid_argument("deposition_path: head '" + head_in.name + "' needs a positive bead width and height");
-  // The machine file's documented defaults for a head built by hand with them unset.
   config::AdditiveHead head = head_in;
   if (!(head.layer_height > 0)) head.layer_height = config::kDefaultLayerHeightFraction * head.bead.height;
   if (!(head.hatch_spacing > 0)) head.hatch_spacing = config::kDefaultHatchSpacingFraction * head.bead.width;
   if (!(head.feed > 0)) head.feed = 1000;
   head.travel_clearance = std::max(0.0, head.travel_clearance);
+  return head;
+}
+
+// The state of one deposition toolpath while it is built, in the work frame: the
+// parameters, the per-column tops of the build, and where the head is.
+class DepositionBuilder {
+ public:
+  DepositionBuilder(const config::AdditiveHead& head, const DepositionOptions& options, Toolpath& path)
+      : head_(head), options_(options), path_(path) {}
+
+  // The layers of `roi_all` less `existing` (both work frame, one lattice).
+  void run(const Solid& roi_all, const Solid& existing);
+
+ private:
+  double face(int k) const { return oz_ + k * h_; }  // bottom face of voxel layer k
+  void take_parameters();
+  void start_columns(const Solid& existing, const IndexBox& roi_box, const IndexBox& existing_box);
+  void deposit_layer(int layer, double zb);
+  // The ROI's voxel layers whose centres lie in the band [zb, zb + layer_height); `k` the highest.
+  SliceMask layer_region(double zb, int& k) const;
+  void drop_blocked(SliceMask& region, int k, int layer, double zb);
+  void warn_overhangs(const SliceMask& region, int layer, double zb);
+  std::vector<Pass> passes_of(const SliceMask& region, int layer, double angle);
+  void finish();
+
+  double corridor_top(Vec2 a, Vec2 b) const;
+  double footprint_top(Vec2 p) const;
+  double clear_height(Vec2 p, double z) const { return std::max(z, footprint_top(p) + gap_); }
+  void move(MoveKind kind, Vec3 to, double feed, bool on, std::string comment = {});
+  void travel_to(Vec2 p, double z);
+
+  config::AdditiveHead head_;
+  const DepositionOptions& options_;
+  Toolpath& path_;
+  // The frame and the material.
+  geometry::Lattice lattice_;
+  double h_ = 1, oz_ = 0;
+  Solid roi_;
+  IndexBox window_;  // the columns: ROI and existing material, with room for the nozzle
+  std::vector<int> existing_top_index_;
+  ColumnMap existing_top_, deposited_top_, travel_top_;
+  SliceMask empty_mask_;
+  // Parameters, mm.
+  double lh_ = 0, s_ = 0, w_ = 0, travel_ = 0, inset_ = 0, min_length_ = 0, support_gap_ = 0, reach_ = 0, gap_ = 0,
+         corridor_ = 0, plate_z_ = 0, z0_ = 0, z_top_ = 0, safe_z_ = 0;
+  std::vector<double> angles_;
+  // Emission state.
+  bool started_ = false;
+  Vec3 at_{};
+  int warnings_overhang_ = 0, warnings_blocked_ = 0, dropped_total_ = 0;
+  double overhang_area_total_ = 0, blocked_area_total_ = 0;
+};
+
+void DepositionBuilder::run(const Solid& roi_all, const Solid& existing) {
+  lattice_ = roi_all.lattice();
+  h_ = lattice_.voxel_size;
+  oz_ = lattice_.origin.z;
+  // Material already there is not deposited again.
+  roi_ = existing.empty() ? roi_all : geometry::subtract(roi_all, existing);
+  const IndexBox roi_box = roi_.bounding_box();
+  const IndexBox existing_box = existing.bounding_box();
+  travel_ = head_.travel_clearance;
+  if (roi_box.empty()) {
+    path_.safe_z = (existing_box.empty() ? oz_ : face(existing_box.hi.z)) + travel_;
+    path_.warnings.push_back("nothing to deposit: the region of influence is empty" +
+                             std::string(roi_all.empty() ? "" : " (all of it is existing material)"));
+    return;
+  }
+  take_parameters();
+  start_columns(existing, roi_box, existing_box);
+  for (int layer = 0;; ++layer) {
+    const double zb = z0_ + layer * lh_;
+    if (zb >= z_top_ - 1e-9) break;
+    deposit_layer(layer, zb);
+  }
+  finish();
+}
+
+void DepositionBuilder::take_parameters() {
+  lh_ = head_.layer_height, s_ = head_.hatch_spacing, w_ = head_.bead.width;
+  inset_ = options_.edge_inset.value_or(w_ / 2);
+  min_length_ = options_.min_segment_length.value_or(w_);
+  support_gap_ = options_.support_gap.value_or(lh_);
+  reach_ = options_.overhang_reach.value_or(w_ / 2);
+  gap_ = std::max(0.0, options_.approach_gap);
+  corridor_ = std::max(w_ / 2, head_.nozzle ? head_.nozzle->diameter / 2 : 0.0);
+  angles_ = options_.raster_angles_deg.empty() ? std::vector<double>{0.0} : options_.raster_angles_deg;
+}
+
+// The column maps over the window, the build plate and safe_z.
+void DepositionBuilder::start_columns(const Solid& existing, const IndexBox& roi_box, const IndexBox& existing_box) {
+  const IndexBox material_box = geometry::box_union(roi_box, existing_box);
+  const int margin = int(std::ceil(corridor_ / h_)) + 2;
+  window_ = {{material_box.lo.x - margin, material_box.lo.y - margin, material_box.lo.z},
+             {material_box.hi.x + margin, material_box.hi.y + margin, material_box.hi.z}};
+  existing_top_index_ = column_top_indices(existing, window_);
+  existing_top_ = ColumnMap(window_, kNone);
+  deposited_top_ = ColumnMap(window_, kNone);
+  travel_top_ = ColumnMap(window_, kNone);
+  double highest_existing = kNone;
+  for (std::size_t i = 0; i < existing_top_.values.size(); ++i)
+    if (existing_top_index_[i] != kNoVoxel) {
+      existing_top_.values[i] = face(existing_top_index_[i] + 1);
+      highest_existing = std::max(highest_existing, existing_top_.values[i]);
+    }
+  travel_top_.values = existing_top_.values;
+  plate_z_ = options_.build_plate_z.value_or(face(material_box.lo.z));
+  empty_mask_ = SliceMask(window_.lo.x, window_.lo.y, window_.hi.x - window_.lo.x, window_.hi.y - window_.lo.y);
+
+  z0_ = face(roi_box.lo.z), z_top_ = face(roi_box.hi.z);
+  safe_z_ = std::max({highest_existing, z_top_, z0_ + std::ceil((z_top_ - z0_) / lh_) * lh_}) +
+            std::max(head_.bead.height, 0.0) + travel_;
+  path_.safe_z = safe_z_;
+}
+
+// The highest material top of any column within the corridor of the straight travel.
+double DepositionBuilder::corridor_top(Vec2 a, Vec2 b) const {
+  const double reach_mm = corridor_ + h_ * std::numbers::sqrt2 / 2;
+  const int x0 = int(std::floor((std::min(a.x, b.x) - reach_mm - lattice_.origin.x) / h_));
+  const int x1 = int(std::floor((std::max(a.x, b.x) + reach_mm - lattice_.origin.x) / h_));
+  const int y0 = int(std::floor((std::min(a.y, b.y) - reach_mm - lattice_.origin.y) / h_));
+  const int y1 = int(std::floor((std::max(a.y, b.y) + reach_mm - lattice_.origin.y) / h_));
+  const double abx = b.x - a.x, aby = b.y - a.y, ab2 = abx * abx + aby * aby;
+  double top = kNone;
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) {
+      const double v = travel_top_.at(x, y);
+      if (v <= top) continue;
+      const double cx = lattice_.origin.x + (x + 0.5) * h_, cy = lattice_.origin.y + (y + 0.5) * h_;
+      double t = ab2 > 0 ? ((cx - a.x) * abx + (cy - a.y) * aby) / ab2 : 0;
+      t = std::clamp(t, 0.0, 1.0);
+      const double dx = cx - (a.x + t * abx), dy = cy - (a.y + t * aby);
+      if (dx * dx + dy * dy <= reach_mm * reach_mm) top = v;
+    }
+  return top;
+}
+
+// The highest material under the bead's footprint at p (columns whose centres lie within
+// half a bead width): a head whose bead bottom is above it by approach_gap clears
+// everything a bead there could touch.
+double DepositionBuilder::footprint_top(Vec2 p) const {
+  const double r = w_ / 2;
+  const int x0 = int(std::floor((p.x - r - lattice_.origin.x) / h_)), x1 = int(std::floor((p.x + r - lattice_.origin.x) / h_));
+  const int y0 = int(std::floor((p.y - r - lattice_.origin.y) / h_)), y1 = int(std::floor((p.y + r - lattice_.origin.y) / h_));
+  double top = kNone;
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) {
+      const double cx = lattice_.origin.x + (x + 0.5) * h_ - p.x, cy = lattice_.origin.y + (y + 0.5) * h_ - p.y;
+      if (cx * cx + cy * cy <= r * r + 1e-9) top = std::max(top, travel_top_.at(x, y));
+    }
+  return top;
+}
+
+void DepositionBuilder::move(MoveKind kind, Vec3 to, double feed, bool on, std::string comment) {
+  PathMove m;
+  m.kind = kind;
+  m.to = to;
+  m.feed = feed;
+  m.process_on = on;
+  m.comment = std::move(comment);
+  path_.moves.push_back(std::move(m));
+  at_ = to;
+}
+
+// Gets to the start of a pass at height z, lifted over the material on the way. Near the
+// work the head moves at feed: out of the bead just laid, and down the last approach_gap
+// onto the surface (neighbouring beads of the layer stand a bead height above it); rapids
+// only where the bead could touch nothing.
+void DepositionBuilder::travel_to(Vec2 p, double z) {
+  const double stop = std::min(safe_z_, clear_height(p, z));
+  if (!started_) {
+    path_.start = {p.x, p.y, safe_z_};
+    move(MoveKind::Rapid, path_.start, 0, false, "above the first pass");
+    started_ = true;
+  } else {
+    const double out = std::min(safe_z_, clear_height({at_.x, at_.y}, at_.z));
+    if (at_.z < out) move(MoveKind::Feed, {at_.x, at_.y, out}, head_.feed, false, "up from the bead");
+    const double lift =
+        std::min(safe_z_, std::max({at_.z, stop, z + travel_, corridor_top({at_.x, at_.y}, p) + travel_}));
+    if (at_.z < lift) move(MoveKind::Rapid, {at_.x, at_.y, lift}, 0, false);
+    move(MoveKind::Rapid, {p.x, p.y, at_.z}, 0, false);
+  }
+  if (at_.z > stop) move(MoveKind::Rapid, {p.x, p.y, stop}, 0, false);
+  if (at_.z > z) move(MoveKind::Feed, {p.x, p.y, z}, head_.feed, false, "down onto the surface");
+}
+
+// Every ROI voxel belongs to exactly one layer. A band thinner than a voxel may hold no
+// centre: it takes the layer its middle lies in, so no layer of the build is skipped.
+SliceMask DepositionBuilder::layer_region(double zb, int& k) const {
+  int k_lo = int(std::ceil((zb - oz_) / h_ - 0.5 - 1e-9));
+  int k_hi = int(std::ceil((zb + lh_ - oz_) / h_ - 0.5 - 1e-9)) - 1;
+  if (k_hi < k_lo) k_lo = k_hi = int(std::floor((zb + lh_ / 2 - oz_) / h_));
+  SliceMask region = slice_of(roi_, k_lo, window_);
+  for (int kk = k_lo + 1; kk <= k_hi; ++kk) region |= slice_of(roi_, kk, window_);
+  k = k_hi;
+  return region;
+}
+
+// Columns with existing material above this layer cannot be reached from +Z.
+void DepositionBuilder::drop_blocked(SliceMask& region, int k, int layer, double zb) {
+  SliceMask blocked = empty_mask_;
+  for (int y = window_.lo.y; y < window_.hi.y; ++y)
+    for (int x = window_.lo.x; x < window_.hi.x; ++x)
+      if (region.at(x, y) &&
+          existing_top_index_[std::size_t(y - window_.lo.y) * std::size_t(existing_top_.nx) + std::size_t(x - window_.lo.x)] > k)
+        blocked.set(x, y);
+  const std::int64_t n = blocked.count();
+  if (n == 0) return;
+  region = region.without(blocked);
+  const double area = double(n) * h_ * h_;
+  blocked_area_total_ += area;
+  if (++warnings_blocked_ <= kMaxWarningsPerKind)
+    path_.warnings.push_back("layer " + std::to_string(layer + 1) + " at z=" + mm(zb) + " mm: " + mm(area) +
+                             " mm^2 lie under existing material, out of reach from the approach side; skipped");
+}
+
+// Overhangs: deposit with nothing (existing, deposited, plate) close enough below.
+void DepositionBuilder::warn_overhangs(const SliceMask& region, int layer, double zb) {
+  SliceMask supported = empty_mask_;
+  const bool on_plate = zb - plate_z_ <= support_gap_ + 1e-9;
+  for (int y = window_.lo.y; y < window_.hi.y; ++y)
+    for (int x = window_.lo.x; x < window_.hi.x; ++x) {
+      const double below = std::max(existing_top_.at(x, y), deposited_top_.at(x, y));
+      if (on_plate || (below > kNone && below >= zb - support_gap_ - 1e-9 && below <= zb + lh_)) supported.set(x, y);
+    }
+  const SliceMask overhang = region.without(grow_by_disc(supported, reach_ / h_));
+  const std::int64_t n = overhang.count();
+  if (n == 0) return;
+  const CellBox b = cell_bounds(overhang);
+  const double area = double(n) * h_ * h_;
+  overhang_area_total_ += area;
+  if (++warnings_overhang_ <= kMaxWarningsPerKind)
+    path_.warnings.push_back("overhang: layer " + std::to_string(layer + 1) + " at z=" + mm(zb) + " mm has " + mm(area) +
+                             " mm^2 of deposit with nothing below it, within x " + mm(lattice_.origin.x + b.x0 * h_) +
+                             ".." + mm(lattice_.origin.x + b.x1 * h_) + ", y " + mm(lattice_.origin.y + b.y0 * h_) +
+                             ".." + mm(lattice_.origin.y + b.y1 * h_) + " mm (work frame)");
+}
+
+// The layer's passes in order: rasters, and the contour before or after them.
+std::vector<Pass> DepositionBuilder::passes_of(const SliceMask& region, int layer, double angle) {
+  const bool reverse_start = (layer / int(angles_.size())) % 2 == 1;
+  std::vector<Pass> contour;
+  RasterResult infill;
+  if (options_.contour != ContourPass::None) {
+    contour = contour_layer(region, lattice_, inset_, min_length_);
+    infill = raster_layer(shrink_by_disc(region, s_ / h_), lattice_, angle, s_, min_length_, inset_, reverse_start);
+  } else {
+    infill = raster_layer(region, lattice_, angle, s_, min_length_, inset_, reverse_start);
+  }
+  dropped_total_ += infill.dropped;
+  std::vector<Pass> passes;
+  if (options_.contour == ContourPass::BeforeInfill) passes = contour;
+  passes.insert(passes.end(), infill.passes.begin(), infill.passes.end());
+  if (options_.contour == ContourPass::AfterInfill) passes.insert(passes.end(), contour.begin(), contour.end());
+  return passes;
+}
+
+void DepositionBuilder::deposit_layer(int layer, double zb) {
+  int k = 0;
+  SliceMask region = layer_region(zb, k);
+  if (region.empty()) return;
+  drop_blocked(region, k, layer, zb);
+  if (region.empty()) return;
+  warn_overhangs(region, layer, zb);
+  // This layer's beads count at their full height for travels from its first pass on.
+  for (int y = window_.lo.y; y < window_.hi.y; ++y)
+    for (int x = window_.lo.x; x < window_.hi.x; ++x)
+      if (region.at(x, y)) travel_top_.ref(x, y) = std::max(travel_top_.at(x, y), zb + head_.bead.height);
+
+  const double angle = angles_[std::size_t(layer) % angles_.size()];
+  bool first_of_layer = true;
+  for (const Pass& p : passes_of(region, layer, angle)) {
+    travel_to(p.points.front(), zb);
+    for (std::size_t i = 1; i < p.points.size(); ++i) {
+      std::string comment;
+      if (first_of_layer) comment = "layer " + std::to_string(layer + 1) + " z=" + mm(zb) + " raster " + mm(angle) + " deg";
+      first_of_layer = false;
+      move(MoveKind::Feed, {p.points[i].x, p.points[i].y, zb}, head_.feed, true, std::move(comment));
+    }
+  }
+  // The layer is down: layer_height of material on its region.
+  for (int y = window_.lo.y; y < window_.hi.y; ++y)
+    for (int x = window_.lo.x; x < window_.hi.x; ++x)
+      if (region.at(x, y)) deposited_top_.ref(x, y) = std::max(deposited_top_.at(x, y), zb + lh_);
+}
+
+// Up and clear of the part, and the summaries of the warnings.
+void DepositionBuilder::finish() {
+  if (started_) {
+    const double out = std::min(safe_z_, clear_height({at_.x, at_.y}, at_.z));
+    if (at_.z < out) move(MoveKind::Feed, {at_.x, at_.y, out}, head_.feed, false, "up from the bead");
+    move(MoveKind::Rapid, {at_.x, at_.y, safe_z_}, 0, false, "clear of the part");
+  }
+  if (warnings_overhang_ > kMaxWarningsPerKind)
+    path_.warnings.push_back("overhang: " + std::to_string(warnings_overhang_) + " layers in all, " +
+                             mm(overhang_area_total_) + " mm^2 of deposit with nothing below it");
+  if (warnings_blocked_ > kMaxWarningsPerKind)
+    path_.warnings.push_back(std::to_string(warnings_blocked_) + " layers in all have ROI under existing material (" +
+                             mm(blocked_area_total_) + " mm^2), skipped");
+  if (dropped_total_ > 0)
+    path_.warnings.push_back(std::to_string(dropped_total_) + " raster segments shorter than " + mm(min_length_) +
+                             " mm dropped (narrow parts of the region stay unfilled)");
+  if (!started_) path_.warnings.push_back("no deposition segment: every part of the region is narrower than a bead");
+}
+
+}  // namespace
+
+Toolpath deposition_path(const Solid& roi_part, const Solid& existing_part, const config::AdditiveHead& head_in,
+                         const config::Setup& setup, const DepositionOptions& options) {
+  const config::AdditiveHead head = with_defaults(head_in);
   const bool has_existing = !existing_part.empty();
   if (has_existing && !(existing_part.lattice() == roi_part.lattice()))
     throw std::invalid_argument("deposition_path: the ROI and the existing material are on different lattices");
@@ -193,239 +498,11 @@ Toolpath deposition_path(const Solid& roi_part, const Solid& existing_part, cons
   Toolpath path;
   path.process = Process::Deposition;
   path.instrument = head.name;
-  path.tool_number = head_tool_number(head, options.fallback_tool_number);
+  path.tool_number = instruments::head_tool_number(head, options.fallback_tool_number);
   path.setup = setup.name;
-
   const Solid roi_all = part_to_work(roi_part, setup.approach);
   const Solid existing = has_existing ? part_to_work(existing_part, setup.approach) : Solid(roi_all.lattice(), {});
-  const geometry::Lattice& lattice = roi_all.lattice();
-  const double h = lattice.voxel_size, oz = lattice.origin.z;
-  auto face = [&](int k) { return oz + k * h; };  // bottom face of voxel layer k
-  // Material already there is not deposited again.
-  const Solid roi = has_existing ? geometry::subtract(roi_all, existing) : roi_all;
-  const IndexBox roi_box = roi.bounding_box();
-  const IndexBox existing_box = existing.bounding_box();
-  const double travel = head.travel_clearance;
-  if (roi_box.empty()) {
-    path.safe_z = (existing_box.empty() ? oz : face(existing_box.hi.z)) + travel;
-    path.warnings.push_back("nothing to deposit: the region of influence is empty" +
-                            std::string(roi_all.empty() ? "" : " (all of it is existing material)"));
-    return path;
-  }
-
-  const double lh = head.layer_height, s = head.hatch_spacing, w = head.bead.width;
-  const double inset = options.edge_inset.value_or(w / 2);
-  const double min_length = options.min_segment_length.value_or(w);
-  const double support_gap = options.support_gap.value_or(lh);
-  const double reach = options.overhang_reach.value_or(w / 2);
-  const double gap = std::max(0.0, options.approach_gap);
-  const double corridor = std::max(w / 2, head.nozzle ? head.nozzle->diameter / 2 : 0.0);
-  const std::vector<double> angles = options.raster_angles_deg.empty() ? std::vector<double>{0.0} : options.raster_angles_deg;
-
-  // Columns: the ROI and existing material, with room for the nozzle's corridor.
-  const IndexBox material_box = geometry::box_union(roi_box, existing_box);
-  const int margin = int(std::ceil(corridor / h)) + 2;
-  const IndexBox window{{material_box.lo.x - margin, material_box.lo.y - margin, material_box.lo.z},
-                        {material_box.hi.x + margin, material_box.hi.y + margin, material_box.hi.z}};
-  const std::vector<int> existing_top_index = column_top_indices(existing, window);
-  ColumnMap existing_top(window, kNone), deposited_top(window, kNone), travel_top(window, kNone);
-  double highest_existing = kNone;
-  for (std::size_t i = 0; i < existing_top.values.size(); ++i)
-    if (existing_top_index[i] != kNoVoxel) {
-      existing_top.values[i] = face(existing_top_index[i] + 1);
-      highest_existing = std::max(highest_existing, existing_top.values[i]);
-    }
-  travel_top.values = existing_top.values;
-  const double plate_z = options.build_plate_z.value_or(face(material_box.lo.z));
-
-  const double z0 = face(roi_box.lo.z), z_top = face(roi_box.hi.z);
-  const double safe_z = std::max({highest_existing, z_top, z0 + std::ceil((z_top - z0) / lh) * lh}) +
-                        std::max(head.bead.height, 0.0) + travel;
-  path.safe_z = safe_z;
-
-  // Emission state.
-  bool started = false;
-  Vec3 at{};
-  int warnings_overhang = 0, warnings_blocked = 0, dropped_total = 0;
-  double overhang_area_total = 0, blocked_area_total = 0;
-
-  auto corridor_top = [&](Vec2 a, Vec2 b) {
-    // The highest material top of any column within the corridor of the straight travel.
-    const double reach_mm = corridor + h * std::numbers::sqrt2 / 2;
-    const int x0 = int(std::floor((std::min(a.x, b.x) - reach_mm - lattice.origin.x) / h));
-    const int x1 = int(std::floor((std::max(a.x, b.x) + reach_mm - lattice.origin.x) / h));
-    const int y0 = int(std::floor((std::min(a.y, b.y) - reach_mm - lattice.origin.y) / h));
-    const int y1 = int(std::floor((std::max(a.y, b.y) + reach_mm - lattice.origin.y) / h));
-    const double abx = b.x - a.x, aby = b.y - a.y, ab2 = abx * abx + aby * aby;
-    double top = kNone;
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) {
-        const double v = travel_top.at(x, y);
-        if (v <= top) continue;
-        const double cx = lattice.origin.x + (x + 0.5) * h, cy = lattice.origin.y + (y + 0.5) * h;
-        double t = ab2 > 0 ? ((cx - a.x) * abx + (cy - a.y) * aby) / ab2 : 0;
-        t = std::clamp(t, 0.0, 1.0);
-        const double dx = cx - (a.x + t * abx), dy = cy - (a.y + t * aby);
-        if (dx * dx + dy * dy <= reach_mm * reach_mm) top = v;
-      }
-    return top;
-  };
-  // The highest material under the bead's footprint at p (columns whose centres lie
-  // within half a bead width): a head whose bead bottom is above it by approach_gap
-  // clears everything a bead there could touch.
-  auto footprint_top = [&](Vec2 p) {
-    const double r = w / 2;
-    const int x0 = int(std::floor((p.x - r - lattice.origin.x) / h)), x1 = int(std::floor((p.x + r - lattice.origin.x) / h));
-    const int y0 = int(std::floor((p.y - r - lattice.origin.y) / h)), y1 = int(std::floor((p.y + r - lattice.origin.y) / h));
-    double top = kNone;
-    for (int y = y0; y <= y1; ++y)
-      for (int x = x0; x <= x1; ++x) {
-        const double cx = lattice.origin.x + (x + 0.5) * h - p.x, cy = lattice.origin.y + (y + 0.5) * h - p.y;
-        if (cx * cx + cy * cy <= r * r + 1e-9) top = std::max(top, travel_top.at(x, y));
-      }
-    return top;
-  };
-  auto move = [&](MoveKind kind, Vec3 to, double feed, bool on, std::string comment = {}) {
-    PathMove m;
-    m.kind = kind;
-    m.to = to;
-    m.feed = feed;
-    m.process_on = on;
-    m.comment = std::move(comment);
-    path.moves.push_back(std::move(m));
-    at = to;
-  };
-  // Gets to the start of a pass at height z, lifted over the material on the way. Near
-  // the work the head moves at feed: out of the bead just laid, and down the last
-  // approach_gap onto the surface (neighbouring beads of the layer stand a bead height
-  // above it); rapids only where the bead could touch nothing.
-  auto clear_height = [&](Vec2 p, double z) { return std::max(z, footprint_top(p) + gap); };
-  auto travel_to = [&](Vec2 p, double z) {
-    const double stop = std::min(safe_z, clear_height(p, z));
-    if (!started) {
-      path.start = {p.x, p.y, safe_z};
-      move(MoveKind::Rapid, path.start, 0, false, "above the first pass");
-      started = true;
-    } else {
-      const double out = std::min(safe_z, clear_height({at.x, at.y}, at.z));
-      if (at.z < out) move(MoveKind::Feed, {at.x, at.y, out}, head.feed, false, "up from the bead");
-      const double lift =
-          std::min(safe_z, std::max({at.z, stop, z + travel, corridor_top({at.x, at.y}, p) + travel}));
-      if (at.z < lift) move(MoveKind::Rapid, {at.x, at.y, lift}, 0, false);
-      move(MoveKind::Rapid, {p.x, p.y, at.z}, 0, false);
-    }
-    if (at.z > stop) move(MoveKind::Rapid, {p.x, p.y, stop}, 0, false);
-    if (at.z > z) move(MoveKind::Feed, {p.x, p.y, z}, head.feed, false, "down onto the surface");
-  };
-
-  const SliceMask empty_mask(window.lo.x, window.lo.y, window.hi.x - window.lo.x, window.hi.y - window.lo.y);
-  for (int layer = 0;; ++layer) {
-    const double zb = z0 + layer * lh;
-    if (zb >= z_top - 1e-9) break;
-    // The voxel layers whose centres lie in [zb, zb + lh): every ROI voxel belongs to
-    // exactly one layer. A band thinner than a voxel may hold no centre: it takes the
-    // layer its middle lies in, so no layer of the build is skipped.
-    int k_lo = int(std::ceil((zb - oz) / h - 0.5 - 1e-9));
-    int k_hi = int(std::ceil((zb + lh - oz) / h - 0.5 - 1e-9)) - 1;
-    if (k_hi < k_lo) k_lo = k_hi = int(std::floor((zb + lh / 2 - oz) / h));
-    SliceMask region = slice_of(roi, k_lo, window);
-    for (int kk = k_lo + 1; kk <= k_hi; ++kk) region |= slice_of(roi, kk, window);
-    if (region.empty()) continue;
-    const int k = k_hi;
-
-    // Columns with existing material above this layer cannot be reached from +Z.
-    SliceMask blocked = empty_mask;
-    for (int y = window.lo.y; y < window.hi.y; ++y)
-      for (int x = window.lo.x; x < window.hi.x; ++x)
-        if (region.at(x, y) &&
-            existing_top_index[std::size_t(y - window.lo.y) * std::size_t(existing_top.nx) + std::size_t(x - window.lo.x)] > k)
-          blocked.set(x, y);
-    if (const std::int64_t n = blocked.count(); n > 0) {
-      region = region.without(blocked);
-      const double area = double(n) * h * h;
-      blocked_area_total += area;
-      if (++warnings_blocked <= kMaxWarningsPerKind)
-        path.warnings.push_back("layer " + std::to_string(layer + 1) + " at z=" + mm(zb) + " mm: " + mm(area) +
-                                " mm^2 lie under existing material, out of reach from the approach side; skipped");
-      if (region.empty()) continue;
-    }
-
-    // Overhangs: deposit with nothing (existing, deposited, plate) close enough below.
-    SliceMask supported = empty_mask;
-    const bool on_plate = zb - plate_z <= support_gap + 1e-9;
-    for (int y = window.lo.y; y < window.hi.y; ++y)
-      for (int x = window.lo.x; x < window.hi.x; ++x) {
-        const double below = std::max(existing_top.at(x, y), deposited_top.at(x, y));
-        if (on_plate || (below > kNone && below >= zb - support_gap - 1e-9 && below <= zb + lh)) supported.set(x, y);
-      }
-    const SliceMask overhang = region.without(grow_by_disc(supported, reach / h));
-    if (const std::int64_t n = overhang.count(); n > 0) {
-      const CellBox b = cell_bounds(overhang);
-      const double area = double(n) * h * h;
-      overhang_area_total += area;
-      if (++warnings_overhang <= kMaxWarningsPerKind)
-        path.warnings.push_back("overhang: layer " + std::to_string(layer + 1) + " at z=" + mm(zb) + " mm has " +
-                                mm(area) + " mm^2 of deposit with nothing below it, within x " +
-                                mm(lattice.origin.x + b.x0 * h) + ".." + mm(lattice.origin.x + b.x1 * h) + ", y " +
-                                mm(lattice.origin.y + b.y0 * h) + ".." + mm(lattice.origin.y + b.y1 * h) +
-                                " mm (work frame)");
-    }
-
-    // This layer's beads count at their full height for travels from its first pass on.
-    for (int y = window.lo.y; y < window.hi.y; ++y)
-      for (int x = window.lo.x; x < window.hi.x; ++x)
-        if (region.at(x, y)) travel_top.ref(x, y) = std::max(travel_top.at(x, y), zb + head.bead.height);
-
-    const double angle = angles[std::size_t(layer) % angles.size()];
-    std::vector<Pass> contour, infill;
-    if (options.contour != ContourPass::None) {
-      contour = contour_layer(region, lattice, inset, min_length);
-      RasterResult r = raster_layer(shrink_by_disc(region, s / h), lattice, angle, s, min_length, inset,
-                                    (layer / int(angles.size())) % 2 == 1);
-      infill = std::move(r.passes);
-      dropped_total += r.dropped;
-    } else {
-      RasterResult r = raster_layer(region, lattice, angle, s, min_length, inset, (layer / int(angles.size())) % 2 == 1);
-      infill = std::move(r.passes);
-      dropped_total += r.dropped;
-    }
-    std::vector<Pass> passes;
-    if (options.contour == ContourPass::BeforeInfill) passes = contour;
-    passes.insert(passes.end(), infill.begin(), infill.end());
-    if (options.contour == ContourPass::AfterInfill) passes.insert(passes.end(), contour.begin(), contour.end());
-
-    bool first_of_layer = true;
-    for (const Pass& p : passes) {
-      travel_to(p.points.front(), zb);
-      for (std::size_t i = 1; i < p.points.size(); ++i) {
-        std::string comment;
-        if (first_of_layer)
-          comment = "layer " + std::to_string(layer + 1) + " z=" + mm(zb) + " raster " + mm(angle) + " deg";
-        first_of_layer = false;
-        move(MoveKind::Feed, {p.points[i].x, p.points[i].y, zb}, head.feed, true, std::move(comment));
-      }
-    }
-    // The layer is down: layer_height of material on its region.
-    for (int y = window.lo.y; y < window.hi.y; ++y)
-      for (int x = window.lo.x; x < window.hi.x; ++x)
-        if (region.at(x, y)) deposited_top.ref(x, y) = std::max(deposited_top.at(x, y), zb + lh);
-  }
-
-  if (started) {
-    const double out = std::min(safe_z, clear_height({at.x, at.y}, at.z));
-    if (at.z < out) move(MoveKind::Feed, {at.x, at.y, out}, head.feed, false, "up from the bead");
-    move(MoveKind::Rapid, {at.x, at.y, safe_z}, 0, false, "clear of the part");
-  }
-  if (warnings_overhang > kMaxWarningsPerKind)
-    path.warnings.push_back("overhang: " + std::to_string(warnings_overhang) + " layers in all, " +
-                            mm(overhang_area_total) + " mm^2 of deposit with nothing below it");
-  if (warnings_blocked > kMaxWarningsPerKind)
-    path.warnings.push_back(std::to_string(warnings_blocked) + " layers in all have ROI under existing material (" +
-                            mm(blocked_area_total) + " mm^2), skipped");
-  if (dropped_total > 0)
-    path.warnings.push_back(std::to_string(dropped_total) + " raster segments shorter than " + mm(min_length) +
-                            " mm dropped (narrow parts of the region stay unfilled)");
-  if (!started) path.warnings.push_back("no deposition segment: every part of the region is narrower than a bead");
+  DepositionBuilder(head, options, path).run(roi_all, existing);
   return path;
 }
 

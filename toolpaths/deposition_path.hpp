@@ -67,12 +67,10 @@ struct DepositionOptions {
   // bead it has just laid, at feed with deposition off.
   double approach_gap = 0.5;
   // The T number for a head whose tool_number is unset (0, e.g. built by hand); the
-  // machine loader always sets it (default 100 + the head's index).
+  // machine loader always sets it (default 100 + the head's index). Plan export passes
+  // instruments::head_tool_number(machine, index), as the simulated machine numbers heads.
   int fallback_tool_number = 0;
 };
-
-// The head's T number: its tool_number when positive, otherwise `fallback`.
-int head_tool_number(const config::AdditiveHead& head, int fallback);
 
 // The deposition toolpath of one additive action.
 //   roi       voxels to deposit, part frame (the action's region of influence)

@@ -1,6 +1,7 @@
 #include "toolpaths/plan_export.hpp"
 
 #include "common/error.hpp"
+#include "instruments/bead.hpp"
 
 namespace hybridctl::toolpaths {
 namespace {
@@ -56,7 +57,7 @@ PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePla
       prog.volume = a.roi.volume();
       if (prog.additive) {
         const config::AdditiveHead* head = nullptr;
-        int index = 0;
+        std::size_t index = 0;
         for (const auto& h : machine.heads) {
           if (h.name == p.capability) {
             head = &h;
@@ -67,7 +68,7 @@ PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePla
         if (!head)
           throw InputError(p.name + " (" + p.label + "): the machine has no head '" + p.capability + "'");
         DepositionOptions d = options.deposition;
-        d.fallback_tool_number = 100 + index;
+        d.fallback_tool_number = instruments::head_tool_number(machine, index);
         prog.path = deposition_path(a.roi, a.before, *head, setup, d);
       } else {
         const config::CuttingTool* tool = machine.find_tool(p.tool_number);

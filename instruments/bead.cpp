@@ -1,0 +1,15 @@
+#include "instruments/bead.hpp"
+
+namespace hybridctl::instruments {
+
+Bead bead_of(const config::AdditiveHead& head) { return Bead{head.bead.shape, head.bead.width, head.bead.height, {}}; }
+
+int head_tool_number(const config::AdditiveHead& head, int fallback) {
+  return head.tool_number > 0 ? head.tool_number : fallback;
+}
+
+int head_tool_number(const config::Machine& machine, std::size_t head_index) {
+  return head_tool_number(machine.heads.at(head_index), config::kDefaultHeadToolNumberBase + int(head_index));
+}
+
+}  // namespace hybridctl::instruments

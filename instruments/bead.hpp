@@ -1,0 +1,41 @@
+#pragma once
+// The bead of an additive head and the T number that selects the head: the one
+// definition the planner's primitives, the deposition generator, plan export and the
+// material simulation use.
+//
+// A bead is the material one deposition pass lays down: an ellipsoid or a cylinder about
+// +Z. Its programmed point is the bead's BOTTOM on its axis: the bead occupies z in
+// [programmed z, programmed z + height]; an ellipsoid bead's centre is at programmed
+// z + height / 2 (semi-axes width/2, width/2, height/2). A deposition toolpath therefore
+// programs the surface the bead is laid on.
+
+#include <cstddef>
+#include <vector>
+
+#include "config/machine.hpp"
+#include "geometry/morphology.hpp"
+
+namespace hybridctl::instruments {
+
+struct Bead {
+  config::BeadShape shape = config::BeadShape::Ellipsoid;
+  double width = 0;   // mm, the bead's diameter across the path
+  double height = 0;  // mm, along +Z
+  // Optional non-cutting body (nozzle) above the programmed point, sections in mm along
+  // +Z, checked like a cutter's body; bead_of leaves it empty (the machine file gives no
+  // nozzle standoff).
+  std::vector<geometry::AxialSection> body;
+};
+
+// The bead of a head: its shape, width and height, with no body.
+Bead bead_of(const config::AdditiveHead& head);
+
+// The T number that selects a head: its tool_number when positive (the machine loader
+// always sets one), otherwise `fallback`.
+int head_tool_number(const config::AdditiveHead& head, int fallback);
+// The T number that selects machine.heads[head_index]: its tool_number when positive,
+// otherwise the machine file's default, config::kDefaultHeadToolNumberBase (100) + the
+// index. Plan export and the simulated machine both number heads by it.
+int head_tool_number(const config::Machine& machine, std::size_t head_index);
+
+}  // namespace hybridctl::instruments

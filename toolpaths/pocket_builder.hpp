@@ -1,0 +1,133 @@
+#pragma once
+// The pocket generator's state while it builds one toolpath (internal to
+// toolpaths/pocket_*.cpp; pocket_path.hpp is the interface, docs/toolpaths.md the
+// description). pocket_path.cpp holds the steps of a run (material, allowed tips, levels,
+// clearing a level) and the moves; pocket_entry.cpp how the tool gets down to a pass
+// (plunge in air, lead-in, ramp).
+
+#include <cmath>
+#include <limits>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "geometry/solid.hpp"
+#include "toolpaths/pocket_cells.hpp"
+#include "toolpaths/pocket_path.hpp"
+#include "toolpaths/pocket_tool.hpp"
+
+namespace hybridctl::toolpaths::pocket {
+
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+// Heights are compared with this slack (mm): a tool tip this close above a voxel centre
+// still counts as touching it.
+inline constexpr double kHeightSlack = 1e-6;
+
+// How many of the nearest starts are tried for a feed link, and for an entry from air,
+// before retracting or ramping.
+inline constexpr std::size_t kLinkCandidates = 8;
+inline constexpr std::size_t kEntryCandidates = 12;
+
+// mm with three decimals, for comments and warnings.
+std::string mm(double v);
+
+class PocketBuilder {
+ public:
+  PocketBuilder(const config::CuttingTool& tool, const PocketOptions& options, Toolpath& path)
+      : tool_(tool), options_(options), path_(path) {}
+
+  Toolpath& run(const geometry::Solid& roi, const geometry::Solid& keep, const geometry::Solid& stock);
+
+ private:
+  using Solid = geometry::Solid;
+  using IndexBox = geometry::IndexBox;
+  using Vec3 = geometry::Vec3;
+  // Levels, top-down (voxel layer indices of the tip).
+  using Levels = std::set<int, std::greater<int>>;
+
+  // The steps of a run.
+  void use_step_sizes();
+  bool take_material(const Solid& roi, const Solid& keep, const Solid& stock);
+  Solid allowed_tips() const;
+  void start_column_tops();
+  Levels cutting_levels() const;
+  SliceMask usable_tips(const Solid& allowed, int k) const;
+  SliceMask useful_tips(const SliceMask& usable, int k) const;
+  void clear_level(const SliceMask& useful, const SliceMask& usable, int k, int level_number);
+  void report_what_stays();
+
+  double centre_z(int k) const { return lattice_.origin.z + (k + 0.5) * h_; }
+  Vec3 at_cell(Cell c, double z) const {
+    return {lattice_.origin.x + (c.x + 0.5) * h_, lattice_.origin.y + (c.y + 0.5) * h_, z};
+  }
+  int top_at(int x, int y) const {
+    if (x < tops_box_.lo.x || x >= tops_box_.hi.x || y < tops_box_.lo.y || y >= tops_box_.hi.y) return kNoVoxel;
+    return tops_[std::size_t(y - tops_box_.lo.y) * std::size_t(tops_box_.hi.x - tops_box_.lo.x) +
+                 std::size_t(x - tops_box_.lo.x)];
+  }
+  // The lowest tip height from which the tool (or only its cutter, or only its body) can
+  // come straight down from safe_z without meeting material; -infinity when nothing
+  // is in reach. Heights at or below it touch material.
+  enum class Part { Whole, Cutter, Body };
+  double contact_height(Cell c, Part part) const;
+  // Where a rapid coming down over `c` stops: material_allowance beside and above the
+  // material the whole tool would meet there, retract_clearance above that, and not below
+  // `at_least` + retract_clearance.
+  double rapid_stop(Cell c, double at_least) const;
+  void refresh_tops(const IndexBox& xy);
+
+  void move(MoveKind kind, Vec3 to, double feed, bool cutting, std::string comment = {});
+  void retract();
+  void cut_paths(std::vector<CellPath> todo, int k, const SliceMask& usable);
+  // Feeds from the current position to the nearest of the starts `cands` of `todo` that a
+  // link inside `usable` reaches, and cuts that path; false when none is in reach.
+  bool link_to_next(std::vector<CellPath>& todo, const std::vector<Candidate>& cands, int k, const SliceMask& usable);
+  void cut_along(const CellPath& p, double zk);
+  CellPath take(std::vector<CellPath>& todo, const Candidate& c) const;
+  Cell current_cell() const {
+    return {int(std::floor((at_.x - lattice_.origin.x) / h_)), int(std::floor((at_.y - lattice_.origin.y) / h_))};
+  }
+  void stamp_run(int k);
+
+  // Entries (pocket_entry.cpp).
+  bool enter(const CellPath& p, int k, const SliceMask& usable);
+  // Where the tool can come straight down in air and reach the start of `p` at level k:
+  // the start itself, or a cell before it on the line of its first leg (a lead-in).
+  std::optional<Cell> air_entry(const CellPath& p, int k, const SliceMask& usable);
+  bool in_air(Cell c, int k);
+  // Rapids from safe_z (or from the first move) to above `c`, then down to `stop`.
+  void go_above(Cell c, double stop);
+  void plunge_in_air(Cell a, Cell b, double zk);
+  void ramp_in(const CellPath& p, double zk, const SliceMask& usable);
+  // Where the ramp from `b` along `d` over `m` cells starts: where the cutter first meets
+  // material over its cells.
+  double ramp_start(Cell b, Cell d, int m, double zk) const;
+
+  config::CuttingTool tool_;
+  PocketOptions options_;
+  Toolpath& path_;
+  geometry::Lattice lattice_;
+  double h_ = 1;
+  ToolModel model_;
+  std::vector<ReachOffset> reach_;
+  double step_over_ = 0;     // mm
+  int down_ = 1, over_ = 1;  // step down and step over in whole voxels
+  IndexBox all_;             // every voxel of the ROI, keep and stock
+  IndexBox work_;            // tip domain
+  Solid remaining_, untouchable_;
+  IndexBox tops_box_;
+  std::vector<int> tops_, untouchable_tops_;
+  double safe_z_ = 0;
+  Vec3 at_{};
+  bool started_ = false;
+  bool at_level_ = false;
+  std::vector<Cell> run_cells_;
+  std::string pending_comment_;
+  std::map<std::pair<int, int>, bool> air_cache_;  // per level, until the next removal
+  int plunges_into_material_ = 0, skipped_entries_ = 0;
+};
+
+}  // namespace hybridctl::toolpaths::pocket
