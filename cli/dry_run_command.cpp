@@ -18,10 +18,11 @@
 #include "cli/run_job.hpp"
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
+#include "config/transport_uri.hpp"
 #include "geometry/mesh.hpp"
-#include "geometry/morphology.hpp"
 #include "geometry/vdb_file.hpp"
 #include "planner/plan_file.hpp"
+#include "planner/deviation.hpp"
 #include "planner/plan_report.hpp"
 
 namespace hybridctl::cli {
@@ -70,7 +71,11 @@ class Simulator {
     while (std::fgets(line, sizeof line, stdout_)) {
       const std::string l(line);
       const std::string key = "listening " + kind + " ";
-      if (l.rfind(key, 0) == 0) return std::stoi(l.substr(l.rfind(':') + 1));
+      if (l.rfind(key, 0) != 0) continue;
+      const std::string address = l.substr(key.size(), l.find_last_not_of("\r\n") + 1 - key.size());
+      const config::HostPortResult at = config::parse_listen_address(address);
+      if (!at.host_port) throw std::runtime_error("the simulator printed '" + l + "': " + at.error);
+      return at.host_port->port;
     }
     throw std::runtime_error("the simulator did not start (see its log)");
   }
@@ -134,7 +139,7 @@ int run_dry_run(const DryRunArgs& a) {
   if (sim_code != 0) throw std::runtime_error("the simulator exited with " + std::to_string(sim_code));
 
   // 4. As built versus as planned.
-  const planner::PlanFile file = planner::read_plan_file(plan_dir);
+  const planner::PlanFile file = planner::to_plan_file(planned, sources, plan_dir);
   const geometry::Solid planned_shape = planner::plan_states(file, file.plans[0]).back();
   const geometry::Solid built = geometry::read_vdb(as_built);
   geometry::Solid built_here(file.lattice, file.domain);
@@ -142,15 +147,11 @@ int run_dry_run(const DryRunArgs& a) {
     if (file.domain.contains(v)) built_here.set(v);
   });
   const geometry::Solid extra = subtract(built_here, planned_shape), missing = subtract(planned_shape, built_here);
-  const geometry::Solid over = subtract(built_here, file.design), under = subtract(file.design, built_here);
-  const double h = file.lattice.voxel_size;
-  const double worst_over = std::max(0.0, geometry::farthest_distance(over, file.design) - (over.empty() ? 0 : h / 2));
-  const double worst_under = std::max(
-      0.0, geometry::farthest_distance(under, complement(file.design, file.domain)) - (under.empty() ? 0 : h / 2));
+  const planner::Deviation d = planner::measure_deviation(built_here, file.design, file.domain, file.tolerance);
   std::printf("as built    %.1f mm³ (planned %.1f mm³): %.1f mm³ beyond the plan, %.1f mm³ of it missing\n",
               built_here.volume(), planned_shape.volume(), extra.volume(), missing.volume());
-  std::printf("vs design   %.1f mm³ over (worst %.2f mm), %.1f mm³ under (worst %.2f mm); tolerance %.2f mm\n", over.volume(),
-              worst_over, under.volume(), worst_under, file.tolerance);
+  std::printf("vs design   %.1f mm³ over (worst %.2f mm), %.1f mm³ under (worst %.2f mm); tolerance %.2f mm\n",
+              d.over_volume, d.worst_over, d.under_volume, d.worst_under, file.tolerance);
   std::printf("wrote       %s: plan/, job/, as-built.vdb, sim-report.json, executed-lines.ngc\n", out.c_str());
   return kSuccess;
 }

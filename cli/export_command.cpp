@@ -19,7 +19,10 @@ namespace hybridctl::cli {
 namespace fs = std::filesystem;
 
 int export_plan_programs(const ExportRequest& request) {
-  const planner::PlanFile file = planner::read_plan_file(request.plan);
+  return export_plan_programs(planner::read_plan_file(request.plan), request);
+}
+
+int export_plan_programs(const planner::PlanFile& file, const ExportRequest& request) {
   const std::string machine_path = request.machine.empty() ? file.machine_file : request.machine;
   const config::Machine machine = config::load_machine(machine_path);
   if (file.plans.empty()) throw InputError(request.plan + ": the plan file holds no plans (the part was not manufacturable)");

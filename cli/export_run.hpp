@@ -3,6 +3,8 @@
 
 #include <string>
 
+#include "planner/plan_file.hpp"
+
 namespace hybridctl::cli {
 
 struct ExportRequest {
@@ -14,5 +16,7 @@ struct ExportRequest {
 };
 
 int export_plan_programs(const ExportRequest& request);
+// The same for a plan already in memory (request.plan names it in messages).
+int export_plan_programs(const planner::PlanFile& file, const ExportRequest& request);
 
 }  // namespace hybridctl::cli

@@ -56,7 +56,6 @@ int run_plan(const PlanArgs& args) {
   bar.finish();
   const planner::ReportSources sources{args.part, args.machine, machine.name};
   std::fputs(planner::plan_summary(result, sources).c_str(), stdout);
-  // Export reads the plan back from its directory, as `hybridctl export` does.
   const std::string plan_dir = !args.output.empty() ? args.output : args.export_dir.empty() ? "" : args.export_dir + "/plan";
   if (!plan_dir.empty()) {
     if (args.output.empty()) std::filesystem::create_directories(args.export_dir);
@@ -77,7 +76,7 @@ int run_plan(const PlanArgs& args) {
     request.output = args.export_dir;
     request.dialect = args.dialect;
     request.machine = args.machine;
-    const int code = export_plan_programs(request);
+    const int code = export_plan_programs(planner::to_plan_file(result, sources, plan_dir), request);
     if (code != kSuccess) return code;
   }
   return result.verdict.manufacturable && !result.plans.empty() ? int(kSuccess) : int(kNotManufacturable);

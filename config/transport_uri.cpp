@@ -1,5 +1,7 @@
 #include "config/transport_uri.hpp"
 
+#include <arpa/inet.h>
+
 #include <algorithm>
 #include <charconv>
 #include <tuple>
@@ -35,33 +37,52 @@ bool is_name_char(char c) {
          c == '.';
 }
 
-/// HOST:PORT -> host, port. Throws Failure mentioning `form`.
-std::pair<std::string, int> split_host_port(std::string_view authority, std::string_view form) {
+/// "[IPv6]:PORT" -> the address and the port's text.
+std::pair<std::string_view, std::string_view> split_bracketed(std::string_view authority, std::string_view form) {
+  const auto close = authority.find(']');
+  if (close == std::string_view::npos) throw Failure{"unterminated '[' in the IPv6 host; expected " + s(form)};
+  const auto host = authority.substr(1, close - 1);
+  const auto rest = authority.substr(close + 1);
+  if (rest.empty() || rest.front() != ':') throw Failure{"missing ':PORT' after the host; expected " + s(form)};
+  if (host.empty() || !std::all_of(host.begin(), host.end(), [](char c) {
+        return c == ':' || c == '.' || (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f') || (c >= 'A' && c <= 'F');
+      }))
+    throw Failure{"bad IPv6 address '" + s(host) + "'; expected " + s(form)};
+  return std::pair{host, rest.substr(1)};
+}
+
+/// HOST:PORT -> host, port. Throws Failure mentioning `form` where the form is at fault.
+HostPort split_host_port(std::string_view authority, HostPortUse use, std::string_view form) {
+  const bool listen = use == HostPortUse::Listen;
+  const std::string listen_form = "expected " + s(form) +
+                                  " with an IPv4 HOST (e.g. 127.0.0.1:1502; port 0 picks a free port)";
   std::string_view host, port;
-  if (!authority.empty() && authority.front() == '[') {
-    const auto close = authority.find(']');
-    if (close == std::string_view::npos) throw Failure{"unterminated '[' in the IPv6 host; expected " + s(form)};
-    host = authority.substr(1, close - 1);
-    const auto rest = authority.substr(close + 1);
-    if (rest.empty() || rest.front() != ':') throw Failure{"missing ':PORT' after the host; expected " + s(form)};
-    port = rest.substr(1);
-    if (host.empty() || !std::all_of(host.begin(), host.end(), [](char c) {
-          return c == ':' || c == '.' || (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f') || (c >= 'A' && c <= 'F');
-        }))
-      throw Failure{"bad IPv6 address '" + s(host) + "'; expected " + s(form)};
+  const bool bracketed = !listen && !authority.empty() && authority.front() == '[';
+  if (bracketed) {
+    std::tie(host, port) = split_bracketed(authority, form);
   } else {
     const auto colon = authority.rfind(':');
-    if (colon == std::string_view::npos) throw Failure{"missing ':PORT' after the host; expected " + s(form)};
+    if (colon == std::string_view::npos) throw Failure{listen ? listen_form : "missing ':PORT' after the host; expected " + s(form)};
     host = authority.substr(0, colon);
     port = authority.substr(colon + 1);
-    if (host.empty()) throw Failure{"missing host; expected " + s(form)};
-    if (!std::all_of(host.begin(), host.end(), is_name_char))
-      throw Failure{"bad host name '" + s(host) + "'; expected " + s(form)};
+    if (host.empty()) throw Failure{listen ? listen_form : "missing host; expected " + s(form)};
+    if (listen && port.empty()) throw Failure{listen_form};
   }
-  const auto number = parse_decimal(port);
-  if (!number || *number < 1 || *number > 65535)
-    throw Failure{"bad port '" + s(port) + "', expected 1..65535 in " + s(form)};
-  return {std::string(host), static_cast<int>(*number)};
+  HostPort out{std::string(host), 0};
+  if (listen) {
+    if (out.host == "localhost") out.host = "127.0.0.1";
+    in_addr addr{};
+    if (::inet_pton(AF_INET, out.host.c_str(), &addr) != 1)
+      throw Failure{"'" + out.host + "' is not an IPv4 address (expected e.g. 127.0.0.1)"};
+  } else if (!bracketed && !std::all_of(host.begin(), host.end(), is_name_char)) {
+    throw Failure{"bad host name '" + s(host) + "'; expected " + s(form)};
+  }
+  const auto number = port.size() > (listen ? 5 : 9) ? std::nullopt : parse_decimal(port);
+  if (!number || *number < (listen ? 0 : 1) || *number > 65535)
+    throw Failure{listen ? "port '" + s(port) + "' is not 0..65535"
+                         : "bad port '" + s(port) + "', expected 1..65535 in " + s(form)};
+  out.port = static_cast<int>(*number);
+  return out;
 }
 
 /// Splits "a=1&b=2" and checks keys against `allowed`; returns key -> value text in order.
@@ -115,7 +136,9 @@ Transport parse_or_throw(std::string_view uri) {
   if (scheme == "modbus-tcp") {
     t.kind = TransportKind::ModbusTcp;
     if (rest.find('/') != std::string_view::npos) throw Failure{"unexpected path; expected " + s(kTcpForm)};
-    std::tie(t.host, t.port) = split_host_port(rest, kTcpForm);
+    const HostPort at = split_host_port(rest, HostPortUse::Connect, kTcpForm);
+    t.host = at.host;
+    t.port = at.port;
     for (const auto& [k, v] : split_query(query, {"unit"}, kTcpForm)) t.unit = number_parameter(k, v, 0, 255, kTcpForm);
   } else if (scheme == "modbus-rtu") {
     t.kind = TransportKind::ModbusRtu;
@@ -149,7 +172,9 @@ Transport parse_or_throw(std::string_view uri) {
     t.kind = TransportKind::Socketcand;
     const auto slash = rest.find('/');
     if (slash == std::string_view::npos) throw Failure{"missing '/CHANNEL'; expected " + s(kCandForm)};
-    std::tie(t.host, t.port) = split_host_port(rest.substr(0, slash), kCandForm);
+    const HostPort at = split_host_port(rest.substr(0, slash), HostPortUse::Connect, kCandForm);
+    t.host = at.host;
+    t.port = at.port;
     const auto channel = rest.substr(slash + 1);
     if (channel.empty() || channel.size() > kMaxInterfaceName ||
         !std::all_of(channel.begin(), channel.end(), is_name_char))
@@ -163,6 +188,32 @@ Transport parse_or_throw(std::string_view uri) {
 }
 
 }  // namespace
+
+HostPortResult parse_host_port(std::string_view text, HostPortUse use, std::string_view form) {
+  try {
+    return HostPortResult{split_host_port(text, use, form), {}};
+  } catch (const Failure& f) {
+    return HostPortResult{std::nullopt, f.message};
+  }
+}
+
+HostPortResult parse_listen_address(std::string_view text) {
+  for (std::string_view scheme : {"tcp://", "modbus-tcp://", "socketcand://"}) {
+    if (text.substr(0, scheme.size()) == scheme) {
+      text.remove_prefix(scheme.size());
+      break;
+    }
+  }
+  if (const auto slash = text.find('/'); slash != std::string_view::npos) text = text.substr(0, slash);  // socketcand channel
+  if (const auto query = text.find('?'); query != std::string_view::npos) text = text.substr(0, query);   // ?unit=N
+  return parse_host_port(text, HostPortUse::Listen, kListenAddressForm);
+}
+
+bool is_loopback_ipv4(const std::string& host) {
+  in_addr addr{};
+  ::inet_pton(AF_INET, host.c_str(), &addr);
+  return (ntohl(addr.s_addr) >> 24) == 127;
+}
 
 TransportUriResult parse_transport_uri(std::string_view uri) {
   try {

@@ -8,6 +8,9 @@
 //   socketcand://HOST:PORT/CHANNEL[?node=N]
 //
 // HOST is a name, an IPv4 address or a bracketed IPv6 address; PORT is 1..65535.
+//
+// The one HOST:PORT parser is here too: a transport URI's authority names a controller
+// to connect to; `hybridctl sim serve` takes addresses to listen on.
 
 #include <optional>
 #include <string>
@@ -34,5 +37,34 @@ struct TransportUriResult {
 };
 
 TransportUriResult parse_transport_uri(std::string_view uri);
+
+/// What a HOST:PORT names, which decides what HOST and PORT may be.
+enum class HostPortUse {
+  Connect,  ///< a peer: HOST a name, an IPv4 address or a bracketed IPv6 address; PORT 1..65535
+  Listen,   ///< a local address: HOST an IPv4 address or "localhost" (127.0.0.1); PORT 0..65535, 0 any free port
+};
+
+struct HostPort {
+  std::string host;  ///< IPv6 without its brackets; "localhost" as 127.0.0.1 for Listen
+  int port = 0;
+};
+
+struct HostPortResult {
+  std::optional<HostPort> host_port;  ///< set on success
+  std::string error;                  ///< otherwise: what is wrong and which form was expected
+};
+
+/// HOST:PORT. `form` is the accepted form of the text around it, for messages.
+HostPortResult parse_host_port(std::string_view text, HostPortUse use, std::string_view form);
+
+/// The accepted forms of parse_listen_address, for messages.
+inline constexpr std::string_view kListenAddressForm = "[tcp://]HOST:PORT";
+
+/// A listen address as `hybridctl sim serve` takes it: HOST:PORT (Listen), optionally as a
+/// tcp://, modbus-tcp:// or socketcand:// URI whose /CHANNEL and ?query are ignored.
+HostPortResult parse_listen_address(std::string_view text);
+
+/// Whether an IPv4 address lies in 127.0.0.0/8.
+bool is_loopback_ipv4(const std::string& host);
 
 }  // namespace hybridctl::config

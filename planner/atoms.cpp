@@ -19,7 +19,7 @@ std::size_t volume_of(const IndexBox& b) { return std::size_t(b.voxel_count()); 
 }  // namespace
 
 AtomDecomposition::AtomDecomposition(const Lattice& lattice, const IndexBox& domain)
-    : lattice_(lattice), domain_(domain), codes_{AtomCode(0)}, labels_(volume_of(domain), 0) {
+    : lattice_(lattice), domain_(domain), codes_{AtomSet(0)}, labels_(volume_of(domain), 0) {
   if (domain.empty()) throw std::invalid_argument("atom decomposition over an empty domain");
 }
 
@@ -69,7 +69,7 @@ void for_each_set_in_row(const Solid& solid, int y, int z, int x0, int x1, Fn fn
 void AtomDecomposition::add_primitive(const Solid& primitive) {
   if (!(primitive.lattice() == lattice_)) throw std::invalid_argument("primitive on a different lattice than the atoms");
   const int bit = primitives_++;
-  for (AtomCode& c : codes_) c.grow(primitives_);
+  for (AtomSet& c : codes_) c.grow(primitives_);
   const std::size_t old_count = codes_.size();
   // Pass 1: how much of each old atom lies inside the primitive, and how big it is.
   using Counts = std::vector<std::int64_t>;
@@ -98,12 +98,12 @@ void AtomDecomposition::add_primitive(const Solid& primitive) {
   for (std::size_t a = 0; a < old_count; ++a) {
     if (inside[a] == 0) continue;
     inside_id[a] = std::int32_t(codes_.size());
-    AtomCode c = codes_[a];
+    AtomSet c = codes_[a];
     c.set(bit);
     codes_.push_back(c);
   }
   std::vector<std::int32_t> renumber(codes_.size(), -1);
-  std::vector<AtomCode> kept;
+  std::vector<AtomSet> kept;
   for (std::size_t a = 0; a < codes_.size(); ++a) {
     if (a < old_count && inside[a] == size[a]) continue;
     renumber[a] = std::int32_t(kept.size());
@@ -132,9 +132,9 @@ AtomDecomposition AtomDecomposition::recompute(const Lattice& lattice, const Ind
   const int n = int(primitives.size());
   d.primitives_ = n;
   d.codes_.clear();
-  std::unordered_map<AtomCode, std::int32_t, AtomCodeHash> ids;
+  std::unordered_map<AtomSet, std::int32_t, AtomSetHash> ids;
   std::size_t i = 0;
-  AtomCode code(n);
+  AtomSet code(n);
   for (int z = domain.lo.z; z < domain.hi.z; ++z)
     for (int y = domain.lo.y; y < domain.hi.y; ++y)
       for (int x = domain.lo.x; x < domain.hi.x; ++x, ++i) {

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "geometry/solid.hpp"
-#include "planner/atom_code.hpp"
+#include "planner/atom_set.hpp"
 
 namespace hybridctl::planner {
 
@@ -35,7 +35,8 @@ class AtomDecomposition {
 
   int primitive_count() const { return primitives_; }
   int atom_count() const { return int(codes_.size()); }
-  const AtomCode& code(int atom) const { return codes_[std::size_t(atom)]; }
+  // The atom's membership code: the primitives it lies inside.
+  const AtomSet& code(int atom) const { return codes_[std::size_t(atom)]; }
   const Lattice& lattice() const { return lattice_; }
   const IndexBox& domain() const { return domain_; }
   // The atom of a voxel of the domain.
@@ -59,7 +60,7 @@ class AtomDecomposition {
   Lattice lattice_;
   IndexBox domain_;
   int primitives_ = 0;
-  std::vector<AtomCode> codes_;
+  std::vector<AtomSet> codes_;
   std::vector<std::int32_t> labels_;  // atom per domain voxel, x fastest
 };
 
@@ -72,7 +73,7 @@ enum class AtomClass { MustIn, MustOut, Free, Violating };
 const char* to_string(AtomClass c);
 
 struct AtomMeasures {
-  AtomCode code;
+  AtomSet code;
   std::int64_t voxels = 0;
   std::int64_t voxels_in_design = 0;
   std::int64_t voxels_in_core = 0;     // inside the design shrunk by the tolerance

@@ -7,6 +7,7 @@
 
 #include "common/error.hpp"
 #include "geometry/vdb_file.hpp"
+#include "planner/plan_report.hpp"
 
 namespace hybridctl::planner {
 namespace {
@@ -69,6 +70,17 @@ class Node {
   std::string file_, pointer_;
 };
 
+// A region as a plan's .vdb gives it (storage around its voxels) on the plan's lattice,
+// clipped to the domain.
+geometry::Solid on_plan_grid(const geometry::Solid& s, const geometry::Lattice& lattice, const geometry::IndexBox& domain) {
+  if (s.lattice() == lattice) return intersect(s, geometry::Solid::filled(lattice, domain));
+  geometry::Solid out(lattice, domain);  // the same grid up to rounding of the origin
+  s.for_each_voxel([&](geometry::Index3 v) {
+    if (domain.contains(v)) out.set(v);
+  });
+  return out;
+}
+
 // A .vdb of the plan on the plan's lattice, clipped to the domain.
 geometry::Solid load_region(const fs::path& directory, const Node& file_node, const geometry::Lattice& lattice,
                             const geometry::IndexBox& domain) {
@@ -83,12 +95,13 @@ geometry::Solid load_region(const fs::path& directory, const Node& file_node, co
                      std::abs(o.y - lattice.origin.y) > 1e-6 * h || std::abs(o.z - lattice.origin.z) > 1e-6 * h))
     throw InputError(path.string() + ": voxel size " + std::to_string(s.voxel_size()) + " mm; expected the plan's grid (" +
                      std::to_string(h) + " mm)");
-  if (s.lattice() == lattice) return intersect(s, geometry::Solid::filled(lattice, domain));
-  geometry::Solid out(lattice, domain);  // the same grid up to rounding of the origin
-  s.for_each_voxel([&](geometry::Index3 v) {
-    if (domain.contains(v)) out.set(v);
-  });
-  return out;
+  return on_plan_grid(s, lattice, domain);
+}
+
+// A solid in memory as its .vdb reads back: a .vdb holds the voxels only, so the storage
+// is what their bounding box needs.
+geometry::Solid as_read_back(const geometry::Solid& s, const geometry::Lattice& lattice, const geometry::IndexBox& domain) {
+  return on_plan_grid(intersect(s, geometry::Solid::filled(s.lattice(), s.bounding_box())), lattice, domain);
 }
 
 }  // namespace
@@ -168,6 +181,29 @@ PlanFile parse_plan_file(std::string_view json_text, const fs::path& json_path) 
       plan.actions.push_back(action);
     }
     f.plans.push_back(std::move(plan));
+  }
+  return f;
+}
+
+PlanFile to_plan_file(const PlanningResult& r, const ReportSources& sources, const fs::path& directory) {
+  PlanFile f;
+  f.directory = directory;
+  f.part = sources.part_path;
+  f.machine_name = sources.machine_name;
+  f.machine_file = sources.machine_path;
+  f.lattice = r.lattice;
+  f.domain = r.domain;
+  f.tolerance = r.tolerance;
+  f.design = as_read_back(r.design, f.lattice, f.domain);
+  for (const Primitive& p : r.primitives) {
+    f.primitives.push_back({p.name, p.label, std::string(to_string(p.kind)), p.mode, p.capability, p.setup,
+                            p.tool_number, as_read_back(p.region, f.lattice, f.domain)});
+  }
+  for (std::size_t k = 0; k < r.plans.size(); ++k) {
+    const Plan& plan = r.plans[k];
+    PlanFilePlan out{int(k + 1), expression(r.problem, plan), plan.cost, {}};
+    for (const PlanStep& step : plan.steps) out.actions.push_back({step.primitive, step.volume, step.cost});
+    f.plans.push_back(std::move(out));
   }
   return f;
 }

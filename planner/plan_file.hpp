@@ -1,7 +1,8 @@
 #pragma once
-// Reading back a plan directory written by `hybridctl plan` (docs/plan-format.md): the
-// grid, the design, every primitive's region and the plans' action sequences, enough to
-// replay any plan on the voxels and turn its actions into G-code.
+// A plan as the plan directory written by `hybridctl plan` holds it (docs/plan-format.md):
+// the grid, the design, every primitive's region and the plans' action sequences, enough
+// to replay any plan on the voxels and turn its actions into G-code. Read back from the
+// directory, or made from the planning result in memory: the same value either way.
 
 #include <filesystem>
 #include <string>
@@ -23,12 +24,14 @@ struct PlanFilePrimitive {
   int tool_number = 0;     // cutting tools
   geometry::Solid region;
   bool raw_stock() const { return kind == "raw-stock"; }
+  friend bool operator==(const PlanFilePrimitive&, const PlanFilePrimitive&) = default;
 };
 
 struct PlanFileAction {
   int primitive = -1;  // index into PlanFile::primitives
   double volume = 0;   // mm^3 deposited or removed as planned
   double cost = 0;     // normalised
+  friend bool operator==(const PlanFileAction&, const PlanFileAction&) = default;
 };
 
 struct PlanFilePlan {
@@ -36,6 +39,7 @@ struct PlanFilePlan {
   std::string expression;
   double cost = 0;
   std::vector<PlanFileAction> actions;
+  friend bool operator==(const PlanFilePlan&, const PlanFilePlan&) = default;
 };
 
 struct PlanFile {
@@ -48,7 +52,12 @@ struct PlanFile {
   geometry::Solid design;
   std::vector<PlanFilePrimitive> primitives;
   std::vector<PlanFilePlan> plans;
+  // Solids compare by their voxels (geometry::Solid's ==).
+  friend bool operator==(const PlanFile&, const PlanFile&) = default;
 };
+
+struct PlanningResult;
+struct ReportSources;
 
 // Reads DIR/plan.json (or the plan.json given) and the .vdb files it names. Throws
 // hybridctl::InputError naming the file and the JSON location of anything missing,
@@ -58,6 +67,12 @@ PlanFile read_plan_file(const std::filesystem::path& plan_json_or_directory);
 // The same from the text of a plan.json that stands at `json_path` (used in messages; the
 // .vdb files are read from its directory, the file itself is not read).
 PlanFile parse_plan_file(std::string_view json_text, const std::filesystem::path& json_path);
+
+// The planning result as write_plan_directory(result, sources, directory) writes it and
+// read_plan_file(directory) reads it back, without the files: equal to what is read back,
+// down to where each solid stores its voxels.
+PlanFile to_plan_file(const PlanningResult& result, const ReportSources& sources,
+                      const std::filesystem::path& directory);
 
 // The states a plan passes through on the voxels: states[0] is empty, states[k] the
 // material after action k (AM unites, SM subtracts), clipped to the domain.

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 
 #include "common/error.hpp"
 #include "geometry/vdb_file.hpp"
@@ -82,21 +83,11 @@ Solid load_primitive_file(const PrimitiveFile& f, const Lattice& lattice) {
   throw InputError(f.path + ": unknown primitive file type '" + ext + "', expected .stl or .vdb");
 }
 
-}  // namespace
+using Progress = std::function<void(const std::string& phase, double fraction)>;
 
-PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& part_name,
-                         const config::Machine& machine, const PlanningOptions& options) {
-  PlanningResult r;
-  PhaseClock clock(r.timings);
-  auto progress = [&](const std::string& phase, double f) {
-    if (options.progress) options.progress(phase, f);
-  };
-  const config::Planning& defaults = machine.planning;
-  const double h = options.voxel_size > 0 ? options.voxel_size : defaults.voxel_size;
-  r.tolerance = options.tolerance >= 0 ? options.tolerance : defaults.tolerance;
-  r.sliver_threshold = options.sliver_threshold >= 0 ? options.sliver_threshold : defaults.sliver_threshold;
-  const int top_k = options.top_k > 0 ? options.top_k : defaults.top_k;
-
+// The design on the planning lattice, clipped to the domain planning looks at.
+void voxelize_design(const geometry::TriangleMesh& part, const std::string& part_name, const config::Machine& machine,
+                     double h, const Progress& progress, PlanningResult& r) {
   r.lattice = {h, {0, 0, 0}};
   r.design = geometry::voxelize(part, r.lattice, part_name, geometry::VoxelizeMethod::ExactScan,
                                 [&](double f) { progress("voxelize", f); });
@@ -108,12 +99,15 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
   const IndexBox region = r.lattice.centers_within(planning_region(machine, bb, r.tolerance));
   r.domain = {{region.lo.x - 2, region.lo.y - 2, region.lo.z - 2}, {region.hi.x + 2, region.hi.y + 2, region.hi.z + 2}};
   r.design = intersect(r.design, Solid::filled(r.lattice, r.domain));
-  clock.lap("voxelize");
+}
 
+// The machine's primitives, then those given as files.
+void add_primitives(const config::Machine& machine, const std::vector<PrimitiveFile>& files, const Progress& progress,
+                    PlanningResult& r) {
   r.primitives = machine_primitives(machine, r.design, r.domain, [&](std::size_t done, std::size_t total, const std::string&) {
     progress("primitives", total ? double(done) / double(total) : 1.0);
   });
-  for (const PrimitiveFile& f : options.extra_primitives) {
+  for (const PrimitiveFile& f : files) {
     Primitive p;
     p.kind = PrimitiveKind::File;
     p.mode = f.mode;
@@ -125,19 +119,23 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
     r.primitives.push_back(std::move(p));
   }
   if (r.primitives.empty()) throw InputError("the machine offers no primitives: expected heads, tools or stocks");
-  clock.lap("primitives");
+}
 
+void decompose_into_atoms(const Progress& progress, PlanningResult& r) {
   r.atoms = AtomDecomposition(r.lattice, r.domain);
   for (std::size_t i = 0; i < r.primitives.size(); ++i) {
     r.atoms.add_primitive(r.primitives[i].region);
     progress("atoms", double(i + 1) / double(r.primitives.size()));
   }
   r.measures = measure_atoms(r.atoms, r.design, make_tolerance_zone(r.design, r.tolerance), r.sliver_threshold);
-  clock.lap("atoms");
+}
 
-  PlanningProblem& p = r.problem;
+// The symbolic problem the search runs on: atoms with volumes and classes, primitives as
+// sets of atoms.
+PlanningProblem symbolic_problem(const PlanningResult& r, const config::Planning& defaults, int max_uses) {
+  PlanningProblem p;
   p.normaliser = r.bounding_box_volume > 0 ? r.bounding_box_volume : 1.0;
-  p.max_uses = options.max_uses;
+  p.max_uses = max_uses;
   p.fixed = {defaults.tool_change_cost, defaults.setup_change_cost, defaults.mode_switch_cost};
   for (const AtomMeasures& m : r.measures) {
     AtomSpec a;
@@ -160,46 +158,60 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
       if (r.atoms.code(a).test(int(i))) s.atoms.set(a);
     p.primitives.push_back(std::move(s));
   }
-  r.verdict = check_manufacturability(p, r.measures, r.lattice);
+  return p;
+}
+
+void search_plans(int top_k, std::int64_t max_expansions, const Progress& progress, PlanningResult& r) {
+  progress("search", 0);
+  SearchOptions search{top_k, max_expansions};
+  r.plans = find_plans(r.problem, search, &r.search);
+  // When the exact search runs out of room before any plan, weighted A* still finds
+  // plans, with a proven bound on how far from the optimum they may be.
+  for (double w : {2.0, 5.0}) {
+    if (!r.plans.empty() || !r.search.limit_reached) break;
+    progress("search", 0.5);
+    search.weight = w;
+    r.plans = find_plans(r.problem, search, &r.search);
+  }
+  progress("search", 1);
+  if (r.plans.empty() && !r.verdict.decided_without_search) {
+    r.verdict.manufacturable = false;
+    r.verdict.summary = r.search.limit_reached
+                            ? "undecided: no plan found within the search limits (" + std::to_string(r.search.expanded) +
+                                  " states expanded, weighted A* included); no atom rules the part out, but the "
+                                  "primitives may not combine into it"
+                            : "no sequence of these primitives makes the design";
+  }
+}
+
+}  // namespace
+
+PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& part_name,
+                         const config::Machine& machine, const PlanningOptions& options) {
+  PlanningResult r;
+  PhaseClock clock(r.timings);
+  const Progress progress = [&](const std::string& phase, double f) {
+    if (options.progress) options.progress(phase, f);
+  };
+  const config::Planning& defaults = machine.planning;
+  const double h = options.voxel_size > 0 ? options.voxel_size : defaults.voxel_size;
+  r.tolerance = options.tolerance >= 0 ? options.tolerance : defaults.tolerance;
+  r.sliver_threshold = options.sliver_threshold >= 0 ? options.sliver_threshold : defaults.sliver_threshold;
+  const int top_k = options.top_k > 0 ? options.top_k : defaults.top_k;
+
+  voxelize_design(part, part_name, machine, h, progress, r);
+  clock.lap("voxelize");
+  add_primitives(machine, options.extra_primitives, progress, r);
+  clock.lap("primitives");
+  decompose_into_atoms(progress, r);
+  clock.lap("atoms");
+  r.problem = symbolic_problem(r, defaults, options.max_uses);
+  r.verdict = check_manufacturability(r.problem, r.measures, r.lattice);
   clock.lap("check");
-
-  if (r.verdict.manufacturable) {
-    progress("search", 0);
-    SearchOptions search{top_k, options.max_expansions};
-    r.plans = find_plans(p, search, &r.search);
-    // When the exact search runs out of room before any plan, weighted A* still finds
-    // plans, with a proven bound on how far from the optimum they may be.
-    for (double w : {2.0, 5.0}) {
-      if (!r.plans.empty() || !r.search.limit_reached) break;
-      progress("search", 0.5);
-      search.weight = w;
-      r.plans = find_plans(p, search, &r.search);
-    }
-    progress("search", 1);
-    if (r.plans.empty() && !r.verdict.decided_without_search) {
-      r.verdict.manufacturable = false;
-      r.verdict.summary = r.search.limit_reached
-                              ? "undecided: no plan found within the search limits (" + std::to_string(r.search.expanded) +
-                                    " states expanded, weighted A* included); no atom rules the part out, but the "
-                                    "primitives may not combine into it"
-                              : "no sequence of these primitives makes the design";
-    }
-  }
+  if (r.verdict.manufacturable) search_plans(top_k, options.max_expansions, progress, r);
   clock.lap("search");
-
-  const Solid air = complement(r.design, r.domain);
-  for (const Plan& plan : r.plans) {
-    const Solid outcome = plan_outcome(r, plan);
-    const Solid over = subtract(outcome, r.design), under = subtract(r.design, outcome);
-    Deviation d;
-    d.over_volume = over.volume();
-    d.under_volume = under.volume();
-    // Centre-to-centre distances less half a voxel: the distance to the surface between.
-    const double worst = std::max(geometry::farthest_distance(over, r.design), geometry::farthest_distance(under, air));
-    d.worst_distance = std::max(0.0, worst - (over.empty() && under.empty() ? 0.0 : h / 2));
-    d.within_tolerance = d.worst_distance <= r.tolerance + 1e-9;
-    r.deviations.push_back(d);
-  }
+  for (const Plan& plan : r.plans)
+    r.deviations.push_back(measure_deviation(plan_outcome(r, plan), r.design, r.domain, r.tolerance));
   clock.lap("deviation");
   return r;
 }

@@ -10,6 +10,7 @@
 #include "geometry/mesh.hpp"
 #include "planner/atoms.hpp"
 #include "planner/check.hpp"
+#include "planner/deviation.hpp"
 #include "planner/machine_primitives.hpp"
 #include "planner/search.hpp"
 
@@ -35,14 +36,6 @@ struct PlanningOptions {
   std::function<void(const std::string& phase, double fraction)> progress;
 };
 
-// How far a plan's outcome is from the design.
-struct Deviation {
-  double over_volume = 0;    // mm^3 of material outside the design
-  double under_volume = 0;   // mm^3 of the design left empty
-  double worst_distance = 0; // mm: the farthest such voxel from the design's surface
-  bool within_tolerance = false;
-};
-
 struct PlanningResult {
   geometry::Lattice lattice;
   geometry::IndexBox domain;
@@ -57,7 +50,7 @@ struct PlanningResult {
   PlanningProblem problem;
   Verdict verdict;
   std::vector<Plan> plans;
-  std::vector<Deviation> deviations;  // one per plan
+  std::vector<Deviation> deviations;  // one per plan: its outcome against the design
   SearchStats search;
   std::vector<std::pair<std::string, double>> timings;  // phase, seconds
 };

@@ -9,28 +9,11 @@
 #include <string>
 #include <vector>
 
+#include "planner/atom_set.hpp"
+
 namespace hybridctl::planner {
 
 enum class Mode { Additive, Subtractive };
-
-// A set of atoms, one bit each.
-class AtomSet {
- public:
-  AtomSet() = default;
-  explicit AtomSet(int atoms) : words_(std::size_t((atoms + 63) / 64), 0) {}
-  bool test(int i) const { return (words_[std::size_t(i / 64)] >> (i % 64)) & 1u; }
-  void set(int i, bool v = true) {
-    auto& w = words_[std::size_t(i / 64)];
-    const std::uint64_t bit = std::uint64_t{1} << (i % 64);
-    w = v ? (w | bit) : (w & ~bit);
-  }
-  const std::vector<std::uint64_t>& words() const { return words_; }
-  std::vector<std::uint64_t>& words() { return words_; }
-  friend bool operator==(const AtomSet&, const AtomSet&) = default;
-
- private:
-  std::vector<std::uint64_t> words_;
-};
 
 struct AtomSpec {
   double volume = 0;  // mm^3

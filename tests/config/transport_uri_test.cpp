@@ -96,4 +96,50 @@ TEST(TransportUri, EachMistakeSaysWhatIsWrongAndTheExpectedForm) {
   }
 }
 
+// The listen addresses of `hybridctl sim serve`: the same HOST:PORT parser, for a local
+// IPv4 address where port 0 means any free port.
+TEST(ListenAddress, AcceptsHostPortWithOrWithoutAScheme) {
+  for (const char* text : {"127.0.0.1:1502", "tcp://127.0.0.1:1502", "modbus-tcp://127.0.0.1:1502?unit=3",
+                                  "socketcand://127.0.0.1:1502/can0", "localhost:1502"}) {
+    const HostPortResult r = parse_listen_address(text);
+    ASSERT_TRUE(r.host_port.has_value()) << text << ": " << r.error;
+    EXPECT_EQ(r.host_port->host, "127.0.0.1") << text;
+    EXPECT_EQ(r.host_port->port, 1502) << text;
+  }
+  const HostPortResult any = parse_listen_address("0.0.0.0:0");
+  ASSERT_TRUE(any.host_port.has_value()) << any.error;
+  EXPECT_EQ(any.host_port->port, 0);
+  EXPECT_FALSE(is_loopback_ipv4("0.0.0.0"));
+  EXPECT_TRUE(is_loopback_ipv4("127.1.2.3"));
+}
+
+TEST(ListenAddress, RefusesWhatCannotBeBound) {
+  const struct {
+    const char* text;
+    const char* says;
+  } cases[] = {
+      {"tcp://127.0.0.1", "expected [tcp://]HOST:PORT with an IPv4 HOST"},
+      {":1502", "expected [tcp://]HOST:PORT"},
+      {"127.0.0.1:", "expected [tcp://]HOST:PORT"},
+      {"controller.local:1502", "'controller.local' is not an IPv4 address"},
+      {"127.0.0.1:70000", "port '70000' is not 0..65535"},
+      {"127.0.0.1:000001", "port '000001' is not 0..65535"},
+      {"127.0.0.1:-1", "port '-1' is not 0..65535"},
+  };
+  for (const auto& c : cases) {
+    const HostPortResult r = parse_listen_address(c.text);
+    EXPECT_FALSE(r.host_port.has_value()) << c.text;
+    EXPECT_NE(r.error.find(c.says), std::string::npos) << c.text << " -> " << r.error;
+  }
+}
+
+TEST(HostPort, ConnectTakesNamesAndIpv6ButNotPortZero) {
+  const HostPortResult v6 = parse_host_port("[::1]:502", HostPortUse::Connect, "modbus-tcp://HOST:PORT");
+  ASSERT_TRUE(v6.host_port.has_value()) << v6.error;
+  EXPECT_EQ(v6.host_port->host, "::1");
+  EXPECT_TRUE(parse_host_port("controller.local:502", HostPortUse::Connect, "F").host_port.has_value());
+  EXPECT_NE(parse_host_port("host:0", HostPortUse::Connect, "F").error.find("bad port '0', expected 1..65535 in F"),
+            std::string::npos);
+}
+
 }  // namespace

@@ -82,7 +82,7 @@ TEST(Atoms, CodesBeyondSixtyFourPrimitivesWork) {
     pointers.push_back(&p);
   }
   EXPECT_TRUE(same_partition(atoms, AtomDecomposition::recompute(kLattice, kDomain, pointers)));
-  const AtomCode& c = atoms.code(atoms.atom_at({5, 0, 0}));
+  const AtomSet& c = atoms.code(atoms.atom_at({5, 0, 0}));
   EXPECT_TRUE(c.test(5));
   EXPECT_TRUE(c.test(25));
   EXPECT_TRUE(c.test(45));

@@ -1,0 +1,65 @@
+// The plan in memory is the plan on disk: to_plan_file(result) equals what
+// read_plan_file gives back from the directory write_plan_directory(result) wrote, down to
+// where each solid stores its voxels (the simulation's domain is a stock's storage box).
+// The bundled bracket on the bundled hybrid machine, at a coarse 1 mm voxel.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+
+#include "config/machine_loader.hpp"
+#include "geometry/mesh.hpp"
+#include "planner/plan_file.hpp"
+#include "planner/plan_report.hpp"
+
+namespace hybridctl::planner {
+namespace {
+
+namespace fs = std::filesystem;
+
+void expect_same_storage(const geometry::Solid& memory, const geometry::Solid& disk, const std::string& what) {
+  EXPECT_EQ(memory, disk) << what;
+  if (!disk.empty()) {
+    EXPECT_EQ(memory.storage_box(), disk.storage_box()) << what;
+  }
+}
+
+TEST(PlanInMemory, EqualsThePlanReadBackFromItsDirectory) {
+  const config::Machine machine = config::load_machine(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
+  const geometry::TriangleMesh part = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/bracket.stl");
+  PlanningOptions options;
+  options.voxel_size = 1.0;
+  options.top_k = 3;
+  const PlanningResult result = plan_part(part, "bracket.stl", machine, options);
+  ASSERT_FALSE(result.plans.empty());
+  const ReportSources sources{"bracket.stl", "hybrid-3axis.yaml", machine.name};
+  const fs::path dir = fs::temp_directory_path() / ("hybridctl-plan-in-memory-" + std::to_string(::getpid()));
+  write_plan_directory(result, sources, dir);
+  const PlanFile disk = read_plan_file(dir);
+  fs::remove_all(dir);
+
+  const PlanFile memory = to_plan_file(result, sources, dir);
+  EXPECT_TRUE(memory == disk);
+  EXPECT_EQ(memory.directory, disk.directory);
+  EXPECT_EQ(memory.lattice, disk.lattice);
+  EXPECT_EQ(memory.domain, disk.domain);
+  EXPECT_EQ(memory.tolerance, disk.tolerance);
+  expect_same_storage(memory.design, disk.design, "design");
+  ASSERT_EQ(memory.primitives.size(), disk.primitives.size());
+  for (std::size_t i = 0; i < disk.primitives.size(); ++i) {
+    EXPECT_TRUE(memory.primitives[i] == disk.primitives[i]) << disk.primitives[i].name;
+    expect_same_storage(memory.primitives[i].region, disk.primitives[i].region, disk.primitives[i].name);
+  }
+  ASSERT_EQ(memory.plans.size(), disk.plans.size());
+  for (std::size_t k = 0; k < disk.plans.size(); ++k) {
+    EXPECT_TRUE(memory.plans[k] == disk.plans[k]) << disk.plans[k].expression;
+    const auto from_memory = plan_states(memory, memory.plans[k]), from_disk = plan_states(disk, disk.plans[k]);
+    ASSERT_EQ(from_memory.size(), from_disk.size());
+    for (std::size_t s = 0; s < from_disk.size(); ++s)
+      expect_same_storage(from_memory[s], from_disk[s], disk.plans[k].expression + " state " + std::to_string(s));
+  }
+}
+
+}  // namespace
+}  // namespace hybridctl::planner
