@@ -215,121 +215,147 @@ std::string format_duration(double seconds) {
   return buf;
 }
 
+namespace {
+
+/// One program's check: the report it fills, and what one line's events and motions add.
+class ProgramCheck {
+ public:
+  ProgramCheck(CheckReport& report, const config::Machine& machine, const CheckOptions& options)
+      : report_(report), machine_(machine), options_(options) {}
+
+  void add_error(Finding f) { finding(report_.errors, std::move(f)); }
+  void event(const Event& e, const ModalState& after);
+  void motion(const Motion& m);
+
+ private:
+  void finding(std::vector<Finding>& list, Finding f) {
+    add(list, report_.errors_not_listed, options_.max_listed, std::move(f));
+  }
+  std::string tool_name(int number) const;
+  void unknown_tool(const Event& e);
+
+  CheckReport& report_;
+  const config::Machine& machine_;
+  const CheckOptions& options_;
+  bool warned_spindle_stopped_ = false;  // one finding per run of feed moves with the spindle stopped
+};
+
+std::string ProgramCheck::tool_name(int number) const {
+  if (const config::CuttingTool* t = machine_.find_tool(number))
+    return "T" + std::to_string(number) + " (" + t->name + ")";
+  if (const config::AdditiveHead* h = machine_.find_head_by_tool(number))
+    return "T" + std::to_string(number) + " (head " + h->name + ")";
+  return "T" + std::to_string(number);
+}
+
+void ProgramCheck::unknown_tool(const Event& e) {
+  std::string known;
+  for (const auto& t : machine_.tools) known += (known.empty() ? "" : ", ") + std::string("T") + std::to_string(t.number);
+  for (const auto& h : machine_.heads)
+    known += (known.empty() ? "" : ", ") + std::string("T") + std::to_string(h.tool_number) + " (" + h.name + ")";
+  finding(report_.tools, Finding{e.line, e.column,
+                                 "T" + std::to_string(e.tool) + " is neither a cutting tool nor a head of machine '" +
+                                     machine_.name + "'; expected one of " + known});
+}
+
+void ProgramCheck::event(const Event& e, const ModalState& after) {
+  const bool head_active_after = machine_.find_head_by_tool(after.tool) != nullptr;
+  switch (e.kind) {
+    case EventKind::ToolChange:
+      ++report_.time.tool_changes;
+      if (e.tool != 0 && !machine_.find_tool(e.tool) && !machine_.find_head_by_tool(e.tool)) unknown_tool(e);
+      break;
+    case EventKind::DepositionOn:
+      if (!head_active_after)
+        finding(report_.process,
+                Finding{e.line, e.column,
+                        "deposition on for head '" + machine_.heads[static_cast<std::size_t>(e.index)].name +
+                            "' while " + (after.tool == 0 ? std::string("no tool") : tool_name(after.tool)) +
+                            " is in the spindle; expected the head selected first (T" + std::to_string(e.tool) + " " +
+                            machine_.gcode.m_codes.tool_change + ")"});
+      break;
+    case EventKind::SpindleStart:
+      if (head_active_after)
+        finding(report_.process, Finding{e.line, e.column,
+                                         "spindle started while " + tool_name(after.tool) +
+                                             " is active; expected a cutting tool in the spindle"});
+      break;
+    case EventKind::Dwell: report_.time.dwell += e.value; break;
+    case EventKind::ProgramStop:
+    case EventKind::OptionalStop: ++report_.time.program_stops; break;
+    case EventKind::ProgramEnd: report_.program_end = true; break;
+    default: break;
+  }
+}
+
+/// The path length of a motion, mm: an arc's (a helix's) or a straight line's.
+double motion_length(const Motion& m) {
+  if (m.is_arc()) {
+    const PlaneAxes pa = plane_axes(m.plane);
+    const double r = std::hypot(get(m.from_machine, pa.first) - get(m.centre_machine, pa.first),
+                                get(m.from_machine, pa.second) - get(m.centre_machine, pa.second));
+    return std::hypot(r * arc_sweep(m), get(m.to_machine, pa.normal) - get(m.from_machine, pa.normal));
+  }
+  return std::hypot(m.to_machine.x - m.from_machine.x, m.to_machine.y - m.from_machine.y,
+                    m.to_machine.z - m.from_machine.z);
+}
+
+void ProgramCheck::motion(const Motion& m) {
+  ++report_.motions;
+  if (m.kind == MotionKind::Rapid)
+    ++report_.rapids;
+  else if (m.kind == MotionKind::Feed)
+    ++report_.feeds;
+  else
+    ++report_.arcs;
+  if (auto v = envelope_violation(m, machine_.envelope, options_.envelope_tolerance))
+    finding(report_.envelope, Finding{m.line, 0, *v});
+  const double t = motion_time(m, machine_.envelope);
+  const double length = motion_length(m);
+  if (m.kind == MotionKind::Rapid) {
+    report_.time.rapid += t;
+    report_.time.rapid_length += length;
+    return;
+  }
+  report_.time.feed += t;
+  report_.time.feed_length += length;
+  const bool cutting_tool = machine_.find_tool(m.tool) != nullptr;
+  if (cutting_tool && m.spindle == SpindleState::Off) {
+    if (!warned_spindle_stopped_)
+      finding(report_.process, Finding{m.line, 0,
+                                       "feed move with " + tool_name(m.tool) +
+                                           " and the spindle stopped; expected the spindle started (" +
+                                           machine_.gcode.m_codes.spindle_cw + ") before cutting"});
+    warned_spindle_stopped_ = true;
+  } else {
+    warned_spindle_stopped_ = false;
+  }
+}
+
+}  // namespace
+
 CheckReport check_program(std::string_view text, const config::Machine& machine, std::string file_name,
                           const CheckOptions& options) {
   CheckReport report;
   report.file = file_name;
   Interpreter interpreter(machine, file_name, options.interpreter);
-  const std::size_t max = options.max_listed;
-  int& more = report.errors_not_listed;
-  bool warned_spindle_stopped = false;  // one finding per run of feed moves with the spindle stopped
-
-  const auto tool_name = [&](int number) -> std::string {
-    if (const config::CuttingTool* t = machine.find_tool(number))
-      return "T" + std::to_string(number) + " (" + t->name + ")";
-    if (const config::AdditiveHead* h = machine.find_head_by_tool(number))
-      return "T" + std::to_string(number) + " (head " + h->name + ")";
-    return "T" + std::to_string(number);
-  };
-
+  ProgramCheck check(report, machine, options);
   for_each_line(text, [&](std::string_view line, int number) {
     report.lines = number;
     const LineResult* result = nullptr;
     try {
       result = &interpreter.execute_line(line, number);
     } catch (const GcodeError& e) {
-      add(report.errors, more, max, Finding{e.line(), e.column(), e.message()});
+      check.add_error(Finding{e.line(), e.column(), e.message()});
       return;
     }
-    const ModalState& after = interpreter.state();
-    const bool head_active_after = machine.find_head_by_tool(after.tool) != nullptr;
-    for (const Event& e : result->events) {
-      switch (e.kind) {
-        case EventKind::ToolChange:
-          ++report.time.tool_changes;
-          if (e.tool != 0 && !machine.find_tool(e.tool) && !machine.find_head_by_tool(e.tool)) {
-            std::string known;
-            for (const auto& t : machine.tools)
-              known += (known.empty() ? "" : ", ") + std::string("T") + std::to_string(t.number);
-            for (const auto& h : machine.heads)
-              known +=
-                  (known.empty() ? "" : ", ") + std::string("T") + std::to_string(h.tool_number) + " (" + h.name + ")";
-            add(report.tools, more, max,
-                Finding{e.line, e.column,
-                        "T" + std::to_string(e.tool) + " is neither a cutting tool nor a head of machine '" +
-                            machine.name + "'; expected one of " + known});
-          }
-          break;
-        case EventKind::DepositionOn:
-          if (!head_active_after)
-            add(report.process, more, max,
-                Finding{e.line, e.column,
-                        "deposition on for head '" + machine.heads[static_cast<std::size_t>(e.index)].name +
-                            "' while " + (after.tool == 0 ? std::string("no tool") : tool_name(after.tool)) +
-                            " is in the spindle; expected the head selected first (T" + std::to_string(e.tool) + " " +
-                            machine.gcode.m_codes.tool_change + ")"});
-          break;
-        case EventKind::SpindleStart:
-          if (head_active_after)
-            add(report.process, more, max,
-                Finding{e.line, e.column,
-                        "spindle started while " + tool_name(after.tool) +
-                            " is active; expected a cutting tool in the spindle"});
-          break;
-        case EventKind::Dwell: report.time.dwell += e.value; break;
-        case EventKind::ProgramStop:
-        case EventKind::OptionalStop: ++report.time.program_stops; break;
-        case EventKind::ProgramEnd: report.program_end = true; break;
-        default: break;
-      }
-    }
-    for (const Motion& m : result->motions) {
-      ++report.motions;
-      if (m.kind == MotionKind::Rapid)
-        ++report.rapids;
-      else if (m.kind == MotionKind::Feed)
-        ++report.feeds;
-      else
-        ++report.arcs;
-      if (auto v = envelope_violation(m, machine.envelope, options.envelope_tolerance))
-        add(report.envelope, more, max, Finding{m.line, 0, *v});
-      const double t = motion_time(m, machine.envelope);
-      double length = 0;
-      if (m.is_arc()) {
-        const PlaneAxes pa = plane_axes(m.plane);
-        const double r = std::hypot(get(m.from_machine, pa.first) - get(m.centre_machine, pa.first),
-                                    get(m.from_machine, pa.second) - get(m.centre_machine, pa.second));
-        length = std::hypot(r * arc_sweep(m), get(m.to_machine, pa.normal) - get(m.from_machine, pa.normal));
-      } else {
-        length = std::hypot(m.to_machine.x - m.from_machine.x, m.to_machine.y - m.from_machine.y,
-                            m.to_machine.z - m.from_machine.z);
-      }
-      if (m.kind == MotionKind::Rapid) {
-        report.time.rapid += t;
-        report.time.rapid_length += length;
-      } else {
-        report.time.feed += t;
-        report.time.feed_length += length;
-        const bool cutting_tool = machine.find_tool(m.tool) != nullptr;
-        if (cutting_tool && m.spindle == SpindleState::Off) {
-          if (!warned_spindle_stopped)
-            add(report.process, more, max,
-                Finding{m.line, 0,
-                        "feed move with " + tool_name(m.tool) +
-                            " and the spindle stopped; expected the spindle started (" +
-                            machine.gcode.m_codes.spindle_cw + ") before cutting"});
-          warned_spindle_stopped = true;
-        } else {
-          warned_spindle_stopped = false;
-        }
-      }
-    }
+    for (const Event& e : result->events) check.event(e, interpreter.state());
+    for (const Motion& m : result->motions) check.motion(m);
   });
   if (!report.program_end)
-    add(report.errors, more, max,
-        Finding{report.lines, 0,
-                "the program has no end; expected " + machine.gcode.m_codes.program_end +
-                    " (or M2/M30) as its last code, as LinuxCNC requires"});
+    check.add_error(Finding{report.lines, 0,
+                            "the program has no end; expected " + machine.gcode.m_codes.program_end +
+                                " (or M2/M30) as its last code, as LinuxCNC requires"});
   report.time.total = report.time.feed + report.time.rapid + report.time.dwell;
   return report;
 }

@@ -187,6 +187,8 @@ class Interpreter {
     CoolantOff
   };
 
+  friend class BlockExecution;  // the steps of run (interpreter_steps.hpp)
+
   MRole role_of(int m) const;
   [[noreturn]] void fail(const Block& b, int column, const std::string& message) const;
   void run(const Block& b, ModalState& s);

@@ -95,7 +95,6 @@ class Parser {
   const std::string& file_name() const { return file_; }
 
  private:
-  [[noreturn]] void fail(int line, int column, const std::string& message) const;
   std::string file_;
 };
 

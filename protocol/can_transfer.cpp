@@ -202,137 +202,140 @@ ReceiveResult CanReassembler::drop(ReceiveResult r, TransferErrorKind kind, std:
   return r;
 }
 
-ReceiveResult CanReassembler::on_frame(const CanFrame& frame, Micros now) {
-  ReceiveResult r;
-  const std::string name = "CAN frame " + hex_id(frame.id);
-  if (frame.id != data_id(node_)) {
-    ++ignored_;
-    r.error = TransferError{TransferErrorKind::WrongId, name + " is not node " + std::to_string(node_) +
-                                                            "'s data identifier " + hex_id(data_id(node_)) + "; ignored"};
-    return r;
-  }
-  const auto b = frame.bytes();
-  if (b.empty() || frame.len > 8) {
-    ++ignored_;
-    r.error = TransferError{TransferErrorKind::Malformed,
-                            name + ": data frame of " + std::to_string(frame.len) + " bytes, expected 1..8; ignored"};
-    return r;
-  }
-  const std::uint8_t type = b[0] >> 4;
-  if (type == kFirstFrame) {
-    if (b.size() < 3) {
-      ++ignored_;
-      r.error = TransferError{TransferErrorKind::Malformed,
-                              name + ": first frame of " + std::to_string(b.size()) + " bytes, expected 4..8; ignored"};
-      return r;
-    }
-    const std::size_t total = (static_cast<std::size_t>(b[0] & 0x0F) << 8) | b[1];
-    const std::uint8_t id = b[2];
-    const std::size_t carried = std::min(kFirstFrameDataBytes, total);
-    if (total == 0 || b.size() < 3 + carried) {
-      ++ignored_;
-      r.error = TransferError{TransferErrorKind::Malformed,
-                              name + ": first frame of " + tid(id) + " announces " + std::to_string(total) +
-                                  " bytes and carries " + std::to_string(b.size() - 3) + "; ignored"};
-      return r;
-    }
-    if (receiving_ && !have_previous_ && id == transfer_id_ && total == total_ &&
-        std::equal(data_.begin(), data_.end(), b.begin() + 3, b.begin() + 3 + static_cast<std::ptrdiff_t>(carried))) {
-      ++duplicates_;  // the same first frame delivered twice; its flow control already went out
-      r.transfer_id = id;
-      r.duplicate = true;
-      return r;
-    }
-    if (receiving_) {
-      r.error = TransferError{TransferErrorKind::Interrupted, tid(transfer_id_) + " dropped after " +
-                                                                  std::to_string(data_.size()) + " of " +
-                                                                  std::to_string(total_) + " bytes: " + tid(id) +
-                                                                  " began"};
-      receiving_ = false;
-    }
-    r.transfer_id = id;
-    if (total > settings_.max_message) {
-      r.error = TransferError{TransferErrorKind::TooLong, tid(id) + ": message of " + std::to_string(total) +
-                                                              " bytes, at most " +
-                                                              std::to_string(settings_.max_message) + " accepted"};
-      r.flow_control = flow(FlowStatus::OverflowAbort, id);
-      return r;
-    }
-    transfer_id_ = id;
-    total_ = total;
-    data_.assign(b.begin() + 3, b.begin() + 3 + static_cast<std::ptrdiff_t>(carried));
-    if (data_.size() == total_) {
-      ++messages_;
-      r.message = std::move(data_);
-      data_.clear();
-      return r;
-    }
-    receiving_ = true;
-    next_index_ = 1;
-    block_count_ = 0;
-    have_previous_ = false;
-    deadline_ = now + settings_.consecutive_timeout;
-    r.flow_control = flow(FlowStatus::ContinueToSend, id);
-    return r;
-  }
-  if (type == kConsecutiveFrame) {
-    const std::uint8_t index = b[0] & 0x0F;
-    if (!receiving_) {
-      ++ignored_;
-      r.error = TransferError{TransferErrorKind::Unexpected,
-                              name + ": consecutive frame " + std::to_string(index) + " with no transfer in progress; ignored"};
-      return r;
-    }
-    r.transfer_id = transfer_id_;
-    const std::span<const std::uint8_t> payload = b.subspan(1);
-    const std::uint8_t previous_index = static_cast<std::uint8_t>((next_index_ + 15) & 0x0F);
-    if (index != next_index_) {
-      if (have_previous_ && index == previous_index &&
-          std::equal(payload.begin(), payload.end(), previous_.begin(), previous_.end())) {
-        ++duplicates_;
-        r.duplicate = true;
-        deadline_ = now + settings_.consecutive_timeout;
-        return r;
-      }
-      ++sequence_errors_;
-      return drop(std::move(r), TransferErrorKind::SequenceError,
-                  tid(transfer_id_) + ": consecutive frame " + std::to_string(index) + " where " +
-                      std::to_string(next_index_) + " was expected after " + std::to_string(data_.size()) + " of " +
-                      std::to_string(total_) + " bytes (a frame was lost, repeated or reordered); transfer dropped",
-                  true);
-    }
-    const std::size_t remaining = total_ - data_.size();
-    const std::size_t expected = std::min(kConsecutiveFrameDataBytes, remaining);
-    if (payload.size() < expected) {
-      ++sequence_errors_;
-      return drop(std::move(r), TransferErrorKind::Malformed,
-                  tid(transfer_id_) + ": consecutive frame " + std::to_string(index) + " carries " +
-                      std::to_string(payload.size()) + " bytes, expected " + std::to_string(expected) +
-                      "; transfer dropped",
-                  true);
-    }
-    data_.insert(data_.end(), payload.begin(), payload.begin() + static_cast<std::ptrdiff_t>(expected));
-    previous_.assign(payload.begin(), payload.end());
-    have_previous_ = true;
-    next_index_ = static_cast<std::uint8_t>((next_index_ + 1) & 0x0F);
-    deadline_ = now + settings_.consecutive_timeout;
-    if (data_.size() == total_) {
-      receiving_ = false;
-      ++messages_;
-      r.message = std::move(data_);
-      data_.clear();
-      return r;
-    }
-    if (settings_.block_size != 0 && ++block_count_ == settings_.block_size) {
-      block_count_ = 0;
-      r.flow_control = flow(FlowStatus::ContinueToSend, transfer_id_);
-    }
-    return r;
-  }
+ReceiveResult CanReassembler::ignore(TransferErrorKind kind, std::string message) {
   ++ignored_;
-  r.error = TransferError{TransferErrorKind::Malformed, name + ": frame type " + std::to_string(type) +
-                                                            " on the data identifier, expected 1 (first) or 2 "
-                                                            "(consecutive); ignored"};
+  ReceiveResult r;
+  r.error = TransferError{kind, std::move(message)};
+  return r;
+}
+
+ReceiveResult CanReassembler::deliver(ReceiveResult r) {
+  ++messages_;
+  r.message = std::move(data_);
+  data_.clear();
+  return r;
+}
+
+// Sorts a frame by kind: wrong identifier or length (ignored), first frame, consecutive
+// frame, anything else (ignored).
+ReceiveResult CanReassembler::on_frame(const CanFrame& frame, Micros now) {
+  const std::string name = "CAN frame " + hex_id(frame.id);
+  if (frame.id != data_id(node_))
+    return ignore(TransferErrorKind::WrongId, name + " is not node " + std::to_string(node_) + "'s data identifier " +
+                                                  hex_id(data_id(node_)) + "; ignored");
+  const auto b = frame.bytes();
+  if (b.empty() || frame.len > 8)
+    return ignore(TransferErrorKind::Malformed,
+                  name + ": data frame of " + std::to_string(frame.len) + " bytes, expected 1..8; ignored");
+  const std::uint8_t type = b[0] >> 4;
+  if (type == kFirstFrame) return on_first_frame(b, name, now);
+  if (type == kConsecutiveFrame) return on_consecutive_frame(b, name, now);
+  return ignore(TransferErrorKind::Malformed, name + ": frame type " + std::to_string(type) +
+                                                  " on the data identifier, expected 1 (first) or 2 "
+                                                  "(consecutive); ignored");
+}
+
+// A first frame begins a transfer (dropping one in progress), unless it repeats the
+// current transfer's first frame; a message that fits it is delivered at once.
+ReceiveResult CanReassembler::on_first_frame(std::span<const std::uint8_t> b, const std::string& name, Micros now) {
+  if (b.size() < 3)
+    return ignore(TransferErrorKind::Malformed,
+                  name + ": first frame of " + std::to_string(b.size()) + " bytes, expected 4..8; ignored");
+  const std::size_t total = (static_cast<std::size_t>(b[0] & 0x0F) << 8) | b[1];
+  const std::uint8_t id = b[2];
+  const std::size_t carried = std::min(kFirstFrameDataBytes, total);
+  if (total == 0 || b.size() < 3 + carried)
+    return ignore(TransferErrorKind::Malformed, name + ": first frame of " + tid(id) + " announces " +
+                                                    std::to_string(total) + " bytes and carries " +
+                                                    std::to_string(b.size() - 3) + "; ignored");
+  const auto first_data = b.begin() + 3, first_data_end = b.begin() + 3 + static_cast<std::ptrdiff_t>(carried);
+  ReceiveResult r;
+  if (receiving_ && !have_previous_ && id == transfer_id_ && total == total_ &&
+      std::equal(data_.begin(), data_.end(), first_data, first_data_end)) {
+    ++duplicates_;  // the same first frame delivered twice; its flow control already went out
+    r.transfer_id = id;
+    r.duplicate = true;
+    return r;
+  }
+  if (receiving_) {
+    r.error = TransferError{TransferErrorKind::Interrupted, tid(transfer_id_) + " dropped after " +
+                                                                std::to_string(data_.size()) + " of " +
+                                                                std::to_string(total_) + " bytes: " + tid(id) +
+                                                                " began"};
+    receiving_ = false;
+  }
+  r.transfer_id = id;
+  if (total > settings_.max_message) {
+    r.error = TransferError{TransferErrorKind::TooLong, tid(id) + ": message of " + std::to_string(total) +
+                                                            " bytes, at most " + std::to_string(settings_.max_message) +
+                                                            " accepted"};
+    r.flow_control = flow(FlowStatus::OverflowAbort, id);
+    return r;
+  }
+  transfer_id_ = id;
+  total_ = total;
+  data_.assign(first_data, first_data_end);
+  if (data_.size() == total_) return deliver(std::move(r));
+  receiving_ = true;
+  next_index_ = 1;
+  block_count_ = 0;
+  have_previous_ = false;
+  deadline_ = now + settings_.consecutive_timeout;
+  r.flow_control = flow(FlowStatus::ContinueToSend, id);
+  return r;
+}
+
+// A consecutive frame continues the transfer in order; a repeat of the previous one is
+// ignored, a gap or a short frame drops the transfer. Every block_size frames the
+// sender gets a continue-to-send.
+ReceiveResult CanReassembler::on_consecutive_frame(std::span<const std::uint8_t> b, const std::string& name,
+                                                   Micros now) {
+  const std::uint8_t index = b[0] & 0x0F;
+  if (!receiving_)
+    return ignore(TransferErrorKind::Unexpected, name + ": consecutive frame " + std::to_string(index) +
+                                                     " with no transfer in progress; ignored");
+  ReceiveResult r;
+  r.transfer_id = transfer_id_;
+  const std::span<const std::uint8_t> payload = b.subspan(1);
+  const std::uint8_t previous_index = static_cast<std::uint8_t>((next_index_ + 15) & 0x0F);
+  if (index != next_index_) {
+    if (have_previous_ && index == previous_index &&
+        std::equal(payload.begin(), payload.end(), previous_.begin(), previous_.end())) {
+      ++duplicates_;
+      r.duplicate = true;
+      deadline_ = now + settings_.consecutive_timeout;
+      return r;
+    }
+    ++sequence_errors_;
+    return drop(std::move(r), TransferErrorKind::SequenceError,
+                tid(transfer_id_) + ": consecutive frame " + std::to_string(index) + " where " +
+                    std::to_string(next_index_) + " was expected after " + std::to_string(data_.size()) + " of " +
+                    std::to_string(total_) + " bytes (a frame was lost, repeated or reordered); transfer dropped",
+                true);
+  }
+  const std::size_t remaining = total_ - data_.size();
+  const std::size_t expected = std::min(kConsecutiveFrameDataBytes, remaining);
+  if (payload.size() < expected) {
+    ++sequence_errors_;
+    return drop(std::move(r), TransferErrorKind::Malformed,
+                tid(transfer_id_) + ": consecutive frame " + std::to_string(index) + " carries " +
+                    std::to_string(payload.size()) + " bytes, expected " + std::to_string(expected) +
+                    "; transfer dropped",
+                true);
+  }
+  data_.insert(data_.end(), payload.begin(), payload.begin() + static_cast<std::ptrdiff_t>(expected));
+  previous_.assign(payload.begin(), payload.end());
+  have_previous_ = true;
+  next_index_ = static_cast<std::uint8_t>((next_index_ + 1) & 0x0F);
+  deadline_ = now + settings_.consecutive_timeout;
+  if (data_.size() == total_) {
+    receiving_ = false;
+    return deliver(std::move(r));
+  }
+  if (settings_.block_size != 0 && ++block_count_ == settings_.block_size) {
+    block_count_ = 0;
+    r.flow_control = flow(FlowStatus::ContinueToSend, transfer_id_);
+  }
   return r;
 }
 

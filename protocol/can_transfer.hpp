@@ -185,6 +185,12 @@ class CanReassembler {
   std::uint64_t frames_ignored() const { return ignored_; }
 
  private:
+  ReceiveResult on_first_frame(std::span<const std::uint8_t> b, const std::string& name, Micros now);
+  ReceiveResult on_consecutive_frame(std::span<const std::uint8_t> b, const std::string& name, Micros now);
+  /// Counts a frame that is no part of any transfer and says why.
+  ReceiveResult ignore(TransferErrorKind kind, std::string message);
+  /// Hands the reassembled message over.
+  ReceiveResult deliver(ReceiveResult r);
   ReceiveResult drop(ReceiveResult r, TransferErrorKind kind, std::string message, bool tell_sender);
   CanFrame flow(FlowStatus status, std::uint8_t transfer_id) const;
 
