@@ -1,5 +1,7 @@
 #pragma once
-// What `hybridctl run` does, shared with `hybridctl dry-run`.
+// `hybridctl run` at a terminal, shared with `hybridctl dry-run`: the plan executor
+// (drivers/executor.hpp) with its status line, prompts (--yes answers them), Ctrl-C as a
+// feed hold, and the final report printed.
 
 #include <string>
 
@@ -15,6 +17,7 @@ struct RunRequest {
   bool yes = false;
 };
 
+// Returns the exit code: kSuccess, or kMachineStopped when the machine stopped first.
 int run_job(const RunRequest& request);
 
 }  // namespace hybridctl::cli

@@ -1,9 +1,11 @@
 #include "drivers/streamer.hpp"
 
 #include <chrono>
+#include <limits>
 #include <thread>
 
 #include "common/error.hpp"
+#include "drivers/backoff.hpp"
 #include "drivers/journal.hpp"
 #include "protocol/chunk.hpp"
 #include "protocol/chunk_acceptor.hpp"
@@ -25,6 +27,11 @@ std::string hex64(std::uint64_t v) {
   return buf;
 }
 
+// The pause after a request the transport gave up on: 100 ms, doubling up to 2 s; it
+// starts again at 100 ms after progress. When to give up is the streamer's own rule
+// (StreamOptions::max_failures_in_row), so the schedule itself never runs out.
+Backoff link_failure_backoff() { return Backoff(std::chrono::milliseconds(100), std::numeric_limits<int>::max()); }
+
 // Alarms the program itself caused: no operator action makes resuming right.
 bool program_fault(AlarmCode a) {
   return a == AlarmCode::EnvelopeViolation || a == AlarmCode::RapidIntoMaterial || a == AlarmCode::DepositionWithoutHead ||
@@ -44,6 +51,7 @@ class Session {
     last_heartbeat_ = Clock::now() - std::chrono::seconds(1);
     int failures_in_row = 0;  // transport failures with no progress in between
     std::uint64_t progress_at_failure = 0;
+    Backoff pause = link_failure_backoff();
     bool reread = false;
     while (true) {
       try {
@@ -64,12 +72,12 @@ class Session {
         // Progress: chunks taken or lines executed since the last failure.
         const std::uint64_t progress = result_.counters.chunks_accepted + status_.last_executed_line;
         failures_in_row = progress != progress_at_failure ? 1 : failures_in_row + 1;
+        if (progress != progress_at_failure) pause = link_failure_backoff();
         progress_at_failure = progress;
         if (!transient || failures_in_row > options_.max_failures_in_row) throw;
         ++result_.counters.transport_errors;
         note(std::string("the link failed (") + e.what() + "); reading the controller's status again");
-        const int doublings = std::min(failures_in_row - 1, 5);
-        std::this_thread::sleep_for(std::min(std::chrono::milliseconds(100 << doublings), std::chrono::milliseconds(2000)));
+        pause.wait_after_failure();
         reread = true;
       }
     }

@@ -32,27 +32,7 @@ void append_integer(std::string& out, std::uint64_t v) {
   while (n > 0) out += digits[--n];
 }
 
-// ------------------------------------------------------------------ text helpers
-
-/// Comment text that cannot end or nest a comment, on one line, printable ASCII.
-std::string comment_text(std::string_view s) {
-  std::string out;
-  out.reserve(s.size());
-  for (char c : s) {
-    if (c == '(')
-      c = '[';
-    else if (c == ')')
-      c = ']';
-    else if (c == '\n' || c == '\r' || c == '\t')
-      c = ' ';
-    else if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f)
-      c = '?';
-    out += c;
-  }
-  return out;
-}
-
-std::string_view to_string(Process p) { return p == Process::Deposition ? "deposition" : "milling"; }
+// ------------------------------------------------------------------ codes
 
 /// The M number of a code such as "M64 P0", or -1.
 int leading_m(const std::string& code) {
@@ -166,14 +146,26 @@ Instrument resolve_instrument(const ActionProgram& a, const config::Machine& mac
   return in;
 }
 
+/// The action's row in the program's table (its lines are filled in as they are written).
+ProgramAction table_row(const ActionProgram& a, const Instrument& in, const config::Setup& setup) {
+  ProgramAction row;
+  row.number = a.action;
+  row.primitive = comment_text(a.primitive);
+  row.mode = a.additive ? ActionMode::Additive : ActionMode::Subtractive;
+  row.process = a.path.process;
+  row.instrument = comment_text(in.head ? "head " + in.head->name : "T" + std::to_string(in.number) + " " + in.tool->name);
+  row.setup = comment_text(setup.name);
+  return row;
+}
+
 class Writer {
  public:
   Writer(const config::Machine& machine, Dialect dialect, const PostOptions& options)
       : machine_(machine), dialect_(dialect), options_(options), fanuc_(dialect == Dialect::Fanuc) {}
 
-  std::string text;
-  std::vector<Origin> origins;       ///< by generated line - 1
-  std::vector<std::size_t> offsets;  ///< where each generated line starts in text
+  std::vector<std::string> lines;
+  std::vector<Origin> origins;         ///< by generated line - 1
+  std::vector<ProgramAction> table;    ///< the program's actions, in order
 
   void program(const std::vector<const ActionProgram*>& actions, int program_number) {
     // Everything that can be refused without writing is checked first.
@@ -219,13 +211,11 @@ class Writer {
   }
 
   void raw_line(std::string_view s) {
-    offsets.push_back(text.size());
-    text += s;
-    text += '\n';
+    lines.emplace_back(s);
     origins.push_back(origin_);
   }
   void line(std::string_view s) {
-    offsets.push_back(text.size());
+    std::string& text = lines.emplace_back();
     if (fanuc_) {
       block_number_ += 10;
       text += 'N';
@@ -233,7 +223,6 @@ class Writer {
       text += ' ';
     }
     text += s;
-    text += '\n';
     origins.push_back(origin_);
   }
   void comment(std::string_view s) { line("(" + comment_text(s) + ")"); }
@@ -268,10 +257,9 @@ class Writer {
   void action(const ActionProgram& a, int index, const Instrument& in, const config::Setup& setup) {
     const Toolpath& p = a.path;
     origin_ = {index, -1, "action start"};
-    comment("action " + std::to_string(a.action) + ": primitive " + a.primitive + ", " +
-            (a.additive ? "additive" : "subtractive") + " " + std::string(to_string(p.process)) + " with " +
-            (in.head ? "head " + in.head->name : "T" + std::to_string(in.number) + " " + in.tool->name) + " in setup " +
-            setup.name);
+    table.push_back(table_row(a, in, setup));
+    table.back().first_line = static_cast<std::uint32_t>(lines.size() + 1);
+    comment(table.back().heading());
     if (!a.label.empty()) comment(a.label);
     std::string summary = "volume ";
     append_number(summary, a.volume);
@@ -378,6 +366,7 @@ class Writer {
       deposition_head_ = nullptr;
     }
     move(MoveKind::Rapid, Vec3{position_.x, position_.y, std::max(p.safe_z, position_.z)}, {}, 0, false);
+    table[static_cast<std::size_t>(index)].last_line = static_cast<std::uint32_t>(lines.size());
   }
 
   /// Writes one move in the work frame; axes whose written value does not change are left out.
@@ -472,12 +461,6 @@ class Writer {
   std::string buffer_, word_;
 };
 
-std::string line_text(const Writer& w, std::size_t line_index) {
-  const std::size_t begin = w.offsets[line_index];
-  const std::size_t end = w.text.find('\n', begin);
-  return w.text.substr(begin, end - begin);
-}
-
 std::string origin_text(const Writer& w, const std::vector<const ActionProgram*>& actions, int line) {
   const std::size_t i = static_cast<std::size_t>(line - 1);
   const Origin& o = w.origins.at(i);
@@ -492,13 +475,13 @@ std::string origin_text(const Writer& w, const std::vector<const ActionProgram*>
   } else {
     out = o.what;
   }
-  return out + " (generated line " + std::to_string(line) + ": " + line_text(w, i) + ")";
+  return out + " (generated line " + std::to_string(line) + ": " + w.lines[i] + ")";
 }
 
 /// Generates, then proves the text runs on the machine: our interpreter accepts every
 /// line and every motion stays in the envelope.
-std::string generate(const std::vector<const ActionProgram*>& actions, const config::Machine& machine,
-                     const PostOptions& options, int program_number) {
+PostedProgram generate(const std::vector<const ActionProgram*>& actions, const config::Machine& machine,
+                       const PostOptions& options, int program_number) {
   const Dialect dialect = options.dialect.value_or(machine.gcode.dialect);
   Writer w(machine, dialect, options);
   try {
@@ -507,12 +490,11 @@ std::string generate(const std::vector<const ActionProgram*>& actions, const con
     throw InputError(std::string("post-processor: ") + e.what() + "; nothing was written");
   }
   Interpreter interpreter(machine, "generated");
-  int number = 0;
-  for_each_line(w.text, [&](std::string_view text, int line) {
-    number = line;
+  for (std::size_t i = 0; i < w.lines.size(); ++i) {
+    const int line = static_cast<int>(i + 1);
     const LineResult* r = nullptr;
     try {
-      r = &interpreter.execute_line(text, line);
+      r = &interpreter.execute_line(w.lines[i], line);
     } catch (const GcodeError& e) {
       throw InputError("post-processor: " + origin_text(w, actions, line) + ": " + e.message() +
                        "; nothing was written");
@@ -521,9 +503,17 @@ std::string generate(const std::vector<const ActionProgram*>& actions, const con
       if (auto v = envelope_violation(m, machine.envelope))
         throw InputError("post-processor: " + origin_text(w, actions, line) + " leaves the envelope of machine '" +
                          machine.name + "' (setup work_origin + work coordinates): " + *v + "; nothing was written");
-  });
-  (void)number;
-  return std::move(w.text);
+  }
+  PostedProgram program;
+  program.origins.reserve(w.origins.size());
+  for (const Origin& o : w.origins) {
+    LineOrigin& to = program.origins.emplace_back();
+    if (o.action >= 0) to.action = static_cast<std::size_t>(o.action);
+    if (o.move >= 0) to.move = static_cast<std::size_t>(o.move);
+  }
+  program.lines = std::move(w.lines);
+  program.actions = std::move(w.table);
+  return program;
 }
 
 }  // namespace
@@ -562,16 +552,25 @@ std::string format_number(double value, bool decimal_point) {
   return s;
 }
 
-std::string write_action(const ActionProgram& action, const config::Machine& machine, const PostOptions& options) {
+PostedProgram post_action(const ActionProgram& action, const config::Machine& machine, const PostOptions& options) {
   const int number = 1 + (machine.gcode.program_number + action.action - 1) % 9999;
   return generate({&action}, machine, options, number);
 }
 
-std::string write_program(const std::vector<ActionProgram>& actions, const config::Machine& machine,
-                          const PostOptions& options) {
+PostedProgram post_program(const std::vector<ActionProgram>& actions, const config::Machine& machine,
+                           const PostOptions& options) {
   std::vector<const ActionProgram*> list;
   for (const auto& a : actions) list.push_back(&a);
   return generate(list, machine, options, machine.gcode.program_number);
+}
+
+std::string write_action(const ActionProgram& action, const config::Machine& machine, const PostOptions& options) {
+  return post_action(action, machine, options).text();
+}
+
+std::string write_program(const std::vector<ActionProgram>& actions, const config::Machine& machine,
+                          const PostOptions& options) {
+  return post_program(actions, machine, options).text();
 }
 
 std::string program_extension(config::Dialect dialect) { return dialect == Dialect::Fanuc ? ".nc" : ".ngc"; }

@@ -1,6 +1,7 @@
 #pragma once
-// The post-processor: plan actions' toolpaths (gcode/toolpath.hpp) into program text in a
-// machine's dialect. docs/gcode.md lists what each dialect gets.
+// The post-processor: plan actions' toolpaths (gcode/toolpath.hpp) into a program in a
+// machine's dialect: its text, and which action and move made each line
+// (gcode/program.hpp). docs/gcode.md lists what each dialect gets.
 //
 //   Rs274ngc (LinuxCNC, the default): header `G21 G90 G17 G94 G40 G49 G80` and the first
 //     setup's work offset; `T.. M6` then `G43 H..`; deposition codes must be M62..M65 P..
@@ -33,6 +34,7 @@
 #include <vector>
 
 #include "config/machine.hpp"
+#include "gcode/program.hpp"
 #include "gcode/toolpath.hpp"
 
 namespace hybridctl::gcode {
@@ -43,13 +45,23 @@ struct PostOptions {
   bool coolant = false;                    ///< coolant on (M8) while milling
 };
 
-/// A standalone program for one action (header, its tool and setup, moves, end).
-/// Throws InputError when the action cannot be written for the machine or leaves its envelope.
-std::string write_action(const ActionProgram& action, const config::Machine& machine, const PostOptions& options = {});
+/// One program running every action in order, with its structure (gcode/program.hpp): for
+/// each line the action (index into `actions`) and the move it came from, and the table of
+/// actions. Throws InputError when an action cannot be written for the machine or leaves
+/// its envelope.
+PostedProgram post_program(const std::vector<ActionProgram>& actions, const config::Machine& machine,
+                           const PostOptions& options = {});
 
-/// One program running every action in order. Same errors as write_action.
+/// A standalone program for one action (header, its tool and setup, moves, end). Same
+/// errors as post_program.
+PostedProgram post_action(const ActionProgram& action, const config::Machine& machine, const PostOptions& options = {});
+
+/// post_program(...).text().
 std::string write_program(const std::vector<ActionProgram>& actions, const config::Machine& machine,
                           const PostOptions& options = {});
+
+/// post_action(...).text().
+std::string write_action(const ActionProgram& action, const config::Machine& machine, const PostOptions& options = {});
 
 /// ".ngc" for rs274ngc, ".nc" for fanuc.
 std::string program_extension(config::Dialect dialect);

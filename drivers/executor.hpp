@@ -1,0 +1,105 @@
+#pragma once
+// The plan executor behind `hybridctl run` (docs/drivers.md, "hybridctl run"): assembles
+// the program (a plan exported and posted now, a program file, or a resumed job's
+// program), prechecks it for the machine, opens or resumes the job's journal, streams the
+// program through drivers/streamer.hpp and keeps, per action of the program, what the
+// final report says: lines executed, time, alarms.
+//
+// The executor prints nothing and asks nobody: what people see and answer goes through
+// JobOperator (the CLI prints, prompts, and watches Ctrl-C).
+//
+// The per-action report comes from the program's action table (gcode/program.hpp): for a
+// plan, the post-processor's; for a program file or a resumed job, what its text says
+// (PostedProgram::from_lines reads back our `(action K: ...)` headings; a file without
+// them runs with no per-action report).
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "drivers/streamer.hpp"
+#include "drivers/transport.hpp"
+
+namespace hybridctl::gcode {
+struct CheckReport;
+}
+
+namespace hybridctl::drivers {
+
+struct JobRequest {
+  std::string input;      ///< plan.json (or its directory) or a G-code program; empty with `resume`
+  std::string machine;    ///< machine file; with `resume`: empty for the journal's
+  std::string transport;  ///< URI; with `resume`: empty for the journal's
+  int rank = 1;           ///< with a plan: which plan, by rank
+  std::string job;        ///< job directory; empty: jobs/IDENTITY (first 12 hex digits)
+  std::string resume;     ///< job directory to resume
+};
+
+/// The job as it starts streaming.
+struct JobStart {
+  std::string job_directory;
+  std::string program;      ///< the program file in the job directory
+  std::size_t lines = 0;
+  std::uint64_t identity = 0;
+  std::string machine;      ///< the machine's name
+  std::string transport;    ///< URI
+  double estimated_s = 0;   ///< `gcode check`'s time estimate
+};
+
+/// Where the stream is, at every status read.
+struct JobProgress {
+  std::size_t action = 0;   ///< 1-based action the next line belongs to; 0 before the first
+  std::size_t actions = 0;
+  std::size_t lines = 0;
+  double done = 0;          ///< fraction of the lines executed
+  double eta_s = 0;         ///< from the rate so far; 0 until 1 % is done
+};
+
+/// What the final report says of one action.
+struct ActionReport {
+  std::string name;                  ///< its heading: "action 2: primitive P7, subtractive milling with ..."
+  std::uint32_t lines = 0;           ///< its lines: from its heading to the next action's (the last: to the end)
+  std::uint32_t executed = 0;        ///< of them
+  std::optional<double> seconds;     ///< from its first executed line to its last (or the end), as the host saw the status
+  std::vector<std::pair<std::string, int>> alarms;  ///< each alarm once, in the order first raised, with how often
+};
+
+struct JobResult {
+  StreamResult stream;
+  TransportCounters transport;
+  std::size_t lines = 0;
+  double seconds = 0;  ///< streaming time
+  std::vector<ActionReport> actions;
+};
+
+/// What the executor tells people and asks them.
+class JobOperator {
+ public:
+  virtual ~JobOperator() = default;
+  /// The program does not pass `gcode check` for the machine; InputError follows.
+  virtual void check_failed(const gcode::CheckReport& report) = 0;
+  /// The job is set up (journal written or opened); streaming starts next.
+  virtual void started(const JobStart& job) = 0;
+  /// Every status read.
+  virtual void progress(const protocol::Status& status, const JobProgress& progress) = 0;
+  /// Something worth a line in the log (reconnects, restarts, where the stream resumed).
+  virtual void note(const std::string& text) = 0;
+  /// A program stop after `status.last_executed_line`; `message` is the operator's
+  /// instruction (the comment before it). True to continue.
+  virtual bool continue_after_stop(const protocol::Status& status, const std::string& message) = 0;
+  /// An alarm the operator may clear. True to clear it and resume.
+  virtual bool clear_alarm(const protocol::Status& status) = 0;
+  /// Polled while streaming: true to hold the feed.
+  virtual bool hold_requested() = 0;
+  /// Held at the operator's request: true to resume, false to abort.
+  virtual bool resume_after_hold(const protocol::Status& status) = 0;
+};
+
+/// Runs the job to its end or its stop. Throws InputError for bad input (a program that
+/// fails its check, a resume into another program; nothing was sent), TransportError when
+/// the controller cannot be reached (the journal lets a later run resume).
+JobResult execute_job(const JobRequest& request, JobOperator& op);
+
+}  // namespace hybridctl::drivers

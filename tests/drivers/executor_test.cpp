@@ -1,0 +1,105 @@
+// The plan executor (drivers/executor.hpp) against `hybridctl sim serve` on loopback: a
+// program file with our action headings gets its per-action report from the program
+// model, the operator is asked at the setup change's program stop with the message before
+// it, and a program that fails its check is refused before anything is opened.
+
+#include "drivers/executor.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "common/error.hpp"
+#include "config/machine_loader.hpp"
+#include "gcode/post.hpp"
+#include "sample_programs.hpp"
+#include "sim_process.hpp"
+#include "transport_fixtures.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace hybridctl;
+
+// Answers yes to everything and remembers what it was told.
+struct RecordingOperator : drivers::JobOperator {
+  bool check_failed_called = false;
+  std::optional<drivers::JobStart> job;
+  int progress_calls = 0;
+  std::vector<std::string> stop_messages;
+  void check_failed(const gcode::CheckReport&) override { check_failed_called = true; }
+  void started(const drivers::JobStart& j) override { job = j; }
+  void progress(const protocol::Status&, const drivers::JobProgress& p) override {
+    ++progress_calls;
+    EXPECT_LE(p.action, p.actions);
+  }
+  void note(const std::string&) override {}
+  bool continue_after_stop(const protocol::Status&, const std::string& message) override {
+    stop_messages.push_back(message);
+    return true;
+  }
+  bool clear_alarm(const protocol::Status&) override { return true; }
+  bool hold_requested() override { return false; }
+  bool resume_after_hold(const protocol::Status&) override { return true; }
+};
+
+std::string write_file(const fs::path& path, const std::string& text) {
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+TEST(Executor, AProgramFileReportsPerActionFromItsHeadings) {
+  const std::string machine_file = test::example_machine();
+  const config::Machine machine = config::load_machine(machine_file);
+  const auto actions = gcode::samples::sample_actions(machine);
+  const gcode::PostedProgram posted = gcode::post_program(actions, machine);
+  const fs::path dir = test::scratch_dir("executor-headings");
+  test::SimProcess sim({"--machine", machine_file, "--modbus", "tcp://127.0.0.1:0", "--time-scale", "0", "--exit-when-done"});
+
+  drivers::JobRequest request;
+  request.input = write_file(dir / "sample.ngc", posted.text());
+  request.machine = machine_file;
+  request.transport = "modbus-tcp://127.0.0.1:" + std::to_string(sim.modbus_port());
+  request.job = (dir / "job").string();
+  RecordingOperator op;
+  const drivers::JobResult result = drivers::execute_job(request, op);
+
+  ASSERT_TRUE(result.stream.completed) << result.stream.stopped_because;
+  ASSERT_TRUE(op.job.has_value());
+  EXPECT_EQ(op.job->lines, posted.lines.size());
+  EXPECT_EQ(result.lines, posted.lines.size());
+  EXPECT_GT(op.progress_calls, 0);
+  // The setup change stops for the operator with its message.
+  ASSERT_EQ(op.stop_messages.size(), 1u);
+  EXPECT_EQ(op.stop_messages[0].rfind("MSG, setup bottom", 0), 0u) << op.stop_messages[0];
+  // One report per heading, named by it; the last runs to the program's end.
+  ASSERT_EQ(result.actions.size(), posted.actions.size());
+  for (std::size_t i = 0; i < result.actions.size(); ++i) {
+    const drivers::ActionReport& a = result.actions[i];
+    EXPECT_EQ(a.name, posted.actions[i].heading());
+    const std::uint32_t last = i + 1 < posted.actions.size() ? posted.actions[i + 1].first_line - 1
+                                                               : std::uint32_t(posted.lines.size());
+    EXPECT_EQ(a.lines, last - posted.actions[i].first_line + 1);
+    EXPECT_EQ(a.executed, a.lines);
+    EXPECT_TRUE(a.seconds.has_value());
+    EXPECT_TRUE(a.alarms.empty());
+  }
+  EXPECT_EQ(sim.wait(std::chrono::seconds(20)), 0);
+}
+
+TEST(Executor, AProgramThatFailsItsCheckIsRefusedBeforeAnythingIsSent) {
+  const fs::path dir = test::scratch_dir("executor-check");
+  drivers::JobRequest request;
+  request.input = write_file(dir / "outside.ngc", "G21 G90\nG54\nG0 X9999 Y0 Z50\nM2\n");
+  request.machine = test::example_machine();
+  request.transport = "modbus-tcp://127.0.0.1:1";  // never opened
+  request.job = (dir / "job").string();
+  RecordingOperator op;
+  EXPECT_THROW(drivers::execute_job(request, op), InputError);
+  EXPECT_TRUE(op.check_failed_called);
+  EXPECT_FALSE(op.job.has_value());
+  EXPECT_FALSE(fs::exists(dir / "job"));
+}
+
+}  // namespace
