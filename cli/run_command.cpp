@@ -14,9 +14,11 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "cli/ranges.hpp"
 #include "cli/run_job.hpp"
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
+#include "drivers/job_restart.hpp"
 #include "drivers/journal.hpp"
 #include "protocol/chunk.hpp"
 #include "drivers/streamer.hpp"
@@ -116,6 +118,10 @@ int run_job(const RunRequest& request) {
     header = journal->header();
     text = gcode::read_text_file(header.program);
     machine = config::load_machine(request.machine.empty() ? header.machine : request.machine);
+    if (request.from_line > 0) {
+      text = drivers::restart_job(*journal, machine, request.from_line);
+      header = journal->header();
+    }
     if (!request.transport.empty()) header.transport = request.transport;
   } else {
     if (request.input.empty()) throw InputError("expected a PLAN.json or PROGRAM.ngc to run, or --resume JOB");
@@ -229,7 +235,8 @@ int run_job(const RunRequest& request) {
   };
 
   drivers::StreamOptions options;
-  options.resume = !request.resume.empty();
+  options.resume = !request.resume.empty() && request.from_line == 0;
+  options.resume_host_hold = options.resume && journal->progress().held_by_host;
   const drivers::StreamResult r = drivers::stream_program(*transport, lines, options, cb, &*journal);
   std::signal(SIGINT, SIG_DFL);
   if (tty) std::fprintf(stderr, "\n");
@@ -286,9 +293,13 @@ void add_run_command(CLI::App& app, Runner& runner) {
   cmd->add_option("-t,--transport", request->transport,
                   "modbus-tcp://HOST:PORT[?unit=N], modbus-rtu:///dev/DEV[?baud=B&parity=P], socketcand://HOST:PORT/CHANNEL, "
                   "socketcan://IFACE; with --resume: the journal's");
-  cmd->add_option("--plan", request->rank, "With a plan: which plan, by rank")->default_val(1)->check(CLI::PositiveNumber);
+  cmd->add_option("--plan", request->rank, "With a plan: which plan, by rank")->default_val(1)->check(greater_than(0));
   cmd->add_option("--job", request->job, "Job directory for the journal and the program (default: jobs/IDENTITY)");
   cmd->add_option("--resume", request->resume, "Continue the job in this directory where the controller is");
+  cmd->add_option("--from-line", request->from_line,
+                  "With --resume, after the controller lost the program: restart it at this line as a new program (the "
+                  "line the loss message names, after checking the machine)")
+      ->needs("--resume");
   cmd->add_flag("-y,--yes", request->yes, "Unattended: continue after program stops and clear recoverable alarms");
   cmd->callback([&runner, request] { runner = [request] { return run_job(*request); }; });
 }
