@@ -67,7 +67,6 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
   r.sliver_threshold = options.sliver_threshold >= 0 ? options.sliver_threshold : defaults.sliver_threshold;
   const int top_k = options.top_k > 0 ? options.top_k : defaults.top_k;
 
-  // Before any grid: a voxel too small for the memory is an input error, not a bad_alloc.
   check_planning_memory(geometry::bounds(part), machine, h, r.tolerance, options.memory_budget, part_name);
   r.lattice = {h, {0, 0, 0}};
   r.design = geometry::voxelize(part, r.lattice, part_name, geometry::VoxelizeMethod::ExactScan,
