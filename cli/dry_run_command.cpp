@@ -15,6 +15,8 @@
 #include <thread>
 
 #include "cli/commands.hpp"
+#include "cli/memory_budget.hpp"
+#include "cli/ranges.hpp"
 #include "cli/run_job.hpp"
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
@@ -33,6 +35,7 @@ namespace fs = std::filesystem;
 struct DryRunArgs {
   std::string part, machine, output = "out/dry-run", transport = "modbus";
   double voxel = 0;
+  std::string memory_budget;
   double time_scale = 0;
 };
 
@@ -102,6 +105,7 @@ int run_dry_run(const DryRunArgs& a) {
   // 1. Plan.
   planner::PlanningOptions options;
   options.voxel_size = a.voxel;
+  options.memory_budget = memory_budget(a.memory_budget);
   const planner::PlanningResult planned = planner::plan_part(geometry::read_stl(a.part), a.part, machine, options);
   const planner::ReportSources sources{a.part, a.machine, machine.name};
   std::fputs(planner::plan_summary(planned, sources).c_str(), stdout);
@@ -167,10 +171,11 @@ void add_dry_run_command(CLI::App& app, Runner& runner) {
   cmd->add_option("-m,--machine", a->machine, "Machine description (YAML)")->required();
   cmd->add_option("--transport", a->transport, "modbus (Modbus TCP) or can (socketcand)")->capture_default_str();
   cmd->add_option("-o,--output", a->output, "Directory for the plan, the job and the simulator's output")->capture_default_str();
-  cmd->add_option("--voxel", a->voxel, "Voxel size in mm (default: the machine file's)")->check(CLI::PositiveNumber);
+  cmd->add_option("--voxel", a->voxel, "Voxel size in mm (default: the machine file's)")->check(greater_than(0));
+  add_memory_budget_option(cmd, a->memory_budget);
   cmd->add_option("--time-scale", a->time_scale, "Simulated seconds per real second (0: as fast as possible)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(at_least(0));
   cmd->callback([&runner, a] { runner = [a] { return run_dry_run(*a); }; });
 }
 

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "cli/commands.hpp"
+#include "cli/ranges.hpp"
 #include "cli/export_run.hpp"
 #include "cli/progress.hpp"
 #include "common/error.hpp"
@@ -81,7 +82,7 @@ void add_export_command(CLI::App& app, Runner& runner) {
                                  "one program per action plus one for the whole plan, and a LinuxCNC tool table");
   cmd->add_option("PLAN", request->plan, "plan.json (or its directory) written by `hybridctl plan -o`")->required();
   cmd->add_option("-o,--output", request->output, "Directory for the programs (created if missing)")->required();
-  cmd->add_option("--plan", request->rank, "Which plan, by rank (1 = cheapest)")->default_val(1)->check(CLI::PositiveNumber);
+  cmd->add_option("--plan", request->rank, "Which plan, by rank (1 = cheapest)")->default_val(1)->check(greater_than(0));
   cmd->add_option("--dialect", request->dialect, "rs274ngc (LinuxCNC) or fanuc (default: the machine file's gcode.dialect)");
   cmd->add_option("-m,--machine", request->machine, "Machine description (default: the file the plan was made with)");
   cmd->callback([&runner, request] { runner = [request] { return export_plan_programs(*request); }; });

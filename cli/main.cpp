@@ -4,6 +4,7 @@
 #include <exception>
 
 #include "cli/commands.hpp"
+#include "cli/ranges.hpp"
 #include "common/error.hpp"
 #include "drivers/transport.hpp"
 
@@ -18,6 +19,7 @@ int main(int argc, char** argv) {
       "hybridctl"};
   app.set_version_flag("--version", "hybridctl 0.1.0");
   app.require_subcommand(1);
+  app.failure_message(failure_message);
   Runner runner;
   add_machine_command(app, runner);
   add_voxelize_command(app, runner);

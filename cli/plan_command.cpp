@@ -3,6 +3,8 @@
 #include <memory>
 
 #include "cli/commands.hpp"
+#include "cli/memory_budget.hpp"
+#include "cli/ranges.hpp"
 #include "cli/export_run.hpp"
 #include "cli/progress.hpp"
 #include "common/error.hpp"
@@ -19,6 +21,7 @@ struct PlanArgs {
   std::string export_dir;
   std::string dialect;
   double voxel = 0;
+  std::string memory_budget;
   double tolerance = -1;
   int top = 0;
   int reuse = 1;
@@ -38,6 +41,7 @@ int run_plan(const PlanArgs& args) {
   const config::Machine machine = config::load_machine(args.machine);
   planner::PlanningOptions options;
   options.voxel_size = args.voxel;
+  options.memory_budget = memory_budget(args.memory_budget);
   options.tolerance = args.tolerance;
   options.top_k = args.top;
   options.max_uses = args.reuse;
@@ -98,14 +102,15 @@ void add_plan_command(CLI::App& app, Runner& runner) {
                   "-o, or to DIR/plan)");
   cmd->add_option("--dialect", args->dialect, "With --export: rs274ngc or fanuc (default: the machine file's)");
   cmd->add_option("--voxel", args->voxel, "Voxel size in mm (default: the machine file's planning.voxel_size)")
-      ->check(CLI::PositiveNumber);
+      ->check(greater_than(0));
+  add_memory_budget_option(cmd, args->memory_budget);
   cmd->add_option("--tolerance", args->tolerance, "Tolerance in mm (default: the machine file's planning.tolerance)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(at_least(0));
   cmd->add_option("--top", args->top, "How many plans (default: the machine file's planning.top_k)")
-      ->check(CLI::PositiveNumber);
+      ->check(greater_than(0));
   cmd->add_option("--reuse", args->reuse, "How often one primitive may appear in a plan")
       ->default_val(1)
-      ->check(CLI::Range(1, 8));
+      ->check(between(1, 8));
   cmd->add_option("--primitive", args->primitive_files,
                   "Extra primitive FILE:am or FILE:sm (STL, or .vdb on the plan's voxel grid); repeatable");
   cmd->callback([&runner, args] { runner = [args] { return run_plan(*args); }; });

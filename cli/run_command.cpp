@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "cli/commands.hpp"
+#include "cli/ranges.hpp"
 #include "cli/run_job.hpp"
 #include "drivers/executor.hpp"
 #include "gcode/check.hpp"
@@ -144,7 +145,7 @@ int run_job(const RunRequest& request) {
   {
     const SigintHold hold;
     result = drivers::execute_job(
-        {request.input, request.machine, request.transport, request.rank, request.job, request.resume}, op);
+        {request.input, request.machine, request.transport, request.rank, request.job, request.resume, request.from_line}, op);
   }
   if (op.tty) std::fprintf(stderr, "\n");
   print_report(result);
@@ -162,9 +163,13 @@ void add_run_command(CLI::App& app, Runner& runner) {
   cmd->add_option("-t,--transport", request->transport,
                   "modbus-tcp://HOST:PORT[?unit=N], modbus-rtu:///dev/DEV[?baud=B&parity=P], socketcand://HOST:PORT/CHANNEL, "
                   "socketcan://IFACE; with --resume: the journal's");
-  cmd->add_option("--plan", request->rank, "With a plan: which plan, by rank")->default_val(1)->check(CLI::PositiveNumber);
+  cmd->add_option("--plan", request->rank, "With a plan: which plan, by rank")->default_val(1)->check(greater_than(0));
   cmd->add_option("--job", request->job, "Job directory for the journal and the program (default: jobs/IDENTITY)");
   cmd->add_option("--resume", request->resume, "Continue the job in this directory where the controller is");
+  cmd->add_option("--from-line", request->from_line,
+                  "With --resume, after the controller lost the program: restart it at this line as a new program (the "
+                  "line the loss message names, after checking the machine)")
+      ->needs("--resume");
   cmd->add_flag("-y,--yes", request->yes, "Unattended: continue after program stops and clear recoverable alarms");
   cmd->callback([&runner, request] { runner = [request] { return run_job(*request); }; });
 }

@@ -14,6 +14,7 @@ struct RunRequest {
   int rank = 1;
   std::string job;        // job directory
   std::string resume;     // job directory to resume
+  unsigned from_line = 0; // with resume: restart the program there (the controller lost it)
   bool yes = false;
 };
 

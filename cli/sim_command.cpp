@@ -5,6 +5,7 @@
 #include <string>
 
 #include "cli/commands.hpp"
+#include "cli/ranges.hpp"
 #include "config/transport_uri.hpp"
 #include "protocol/codes.hpp"
 #include "sim/wire/serve.hpp"
@@ -72,32 +73,32 @@ void add_sim_command(CLI::App& app, Runner& runner) {
   serve_cmd->add_option("--parity", r->parity, "RTU parity: N, E or O")->capture_default_str()->check(CLI::IsMember({"N", "E", "O"}));
   serve_cmd->add_option("--unit", r->unit, "RTU unit (slave) id; TCP answers any unit")
       ->capture_default_str()
-      ->check(CLI::Range(1, 247));
+      ->check(between(1, 247));
   serve_cmd->add_option("--socketcand", r->socketcand, "socketcand endpoint HOST:PORT (port 0: a free port)")
       ->check(listen_address_validator());
   serve_cmd->add_option("--socketcan", r->socketcan, "Kernel CAN interface (e.g. vcan0)");
-  serve_cmd->add_option("--node", r->node, "CAN node id of the controller")->capture_default_str()->check(CLI::Range(1, 127));
+  serve_cmd->add_option("--node", r->node, "CAN node id of the controller")->capture_default_str()->check(between(1, 127));
   serve_cmd->add_option("--can-bitrate", r->can_bitrate,
                         "socketcand: pace frames as a CAN bus at this bit rate would (e.g. 1000000; 0: no pacing)")
       ->capture_default_str();
   serve_cmd->add_option("--can-block-size", r->can_block_size,
                         "CAN: consecutive frames the host may send per flow control (0: a whole chunk at once)")
       ->capture_default_str()
-      ->check(CLI::Range(0, 255));
+      ->check(between(0, 255));
   serve_cmd->add_option("--status-period-ms", r->status_period_ms, "CAN: a status snapshot at least this often")
       ->capture_default_str()
-      ->check(CLI::Range(1, 60000));
+      ->check(between(1, 60000));
   serve_cmd->add_option("--time-scale", r->time_scale,
                         "Virtual seconds per real second (0: execute as fast as possible)")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1e6));
+      ->check(between(0.0, 1e6));
   serve_cmd->add_option("--buffer-bytes", r->buffer_bytes, "Program buffer (payload bytes)")
       ->capture_default_str()
-      ->check(CLI::Range(256u, 16u << 20));
+      ->check(between(256u, 16u << 20));
   serve_cmd->add_option("--heartbeat-timeout", r->heartbeat_timeout_s,
                         "Seconds RUNNING without a heartbeat change before the alarm (0: never)")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 65.0));
+      ->check(between(0.0, 65.0));
   auto* stock_plan = serve_cmd->add_option("--stock", r->stock_plan,
                                            "Stock from a plan (plan.json or its directory): the plan's raw stock; the "
                                            "design shrunk by the tolerance is protected");

@@ -13,6 +13,7 @@
 #include <thread>
 
 #include "cli/commands.hpp"
+#include "cli/ranges.hpp"
 #include "protocol/codes.hpp"
 #include "protocol/messages.hpp"
 #include "drivers/transport.hpp"
@@ -217,10 +218,10 @@ void add_status_command(CLI::App& app, Runner& runner) {
       ->required();
   auto* watch = cmd->add_option("--watch,-w", request->interval_s, "Refresh every SECONDS (default 1) until Ctrl-C")
                     ->expected(0, 1)
-                    ->check(CLI::Range(0.05, 3600.0));
+                    ->check(between(0.05, 3600.0));
   cmd->add_option("--count", request->count, "With --watch: stop after N updates (0: until Ctrl-C)")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--timeout", request->timeout_ms, "Response timeout, ms (default 1000)")->check(CLI::Range(1, 60000));
+      ->check(at_least(0));
+  cmd->add_option("--timeout", request->timeout_ms, "Response timeout, ms (default 1000)")->check(between(1, 60000));
   cmd->callback([&runner, request, watch] {
     request->watch = watch->count() > 0;
     runner = [request] { return run_status(*request); };

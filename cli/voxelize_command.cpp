@@ -4,6 +4,8 @@
 #include <memory>
 
 #include "cli/commands.hpp"
+#include "cli/memory_budget.hpp"
+#include "cli/ranges.hpp"
 #include "cli/progress.hpp"
 #include "common/error.hpp"
 #include "geometry/png_slices.hpp"
@@ -23,6 +25,7 @@ struct VoxelizeArgs {
   std::string png_dir;
   double voxel = 0.5;
   std::string method = "exact";
+  std::string memory_budget;
 };
 
 int run_voxelize(const VoxelizeArgs& args) {
@@ -36,6 +39,9 @@ int run_voxelize(const VoxelizeArgs& args) {
     throw InputError("--voxel " + std::to_string(args.voxel) + ": the part's bounding box would need " +
                      std::to_string(bits / 8e9) + " GB of voxels; expected a larger voxel size");
   }
+  check_memory_budget([&](double h) { return solid_bytes(b, h, 1); }, args.voxel,
+                      memory_budget(args.memory_budget) ? memory_budget(args.memory_budget) : default_memory_budget(),
+                      "voxelizing " + args.part + " at " + std::to_string(args.voxel) + " mm");
   const Lattice lattice{args.voxel, {0, 0, 0}};
   Solid solid;
   {
@@ -74,7 +80,8 @@ void add_voxelize_command(CLI::App& app, Runner& runner) {
   cmd->add_option("PART", args->part, "Part mesh, binary or ASCII STL, in mm")->required();
   cmd->add_option("--voxel", args->voxel, "Voxel edge length in mm")
       ->default_val(0.5)
-      ->check(CLI::PositiveNumber);
+      ->check(greater_than(0));
+  add_memory_budget_option(cmd, args->memory_budget);
   cmd->add_option("-o,--output", args->output, "Output .vdb file (fog volume named 'density')")->required();
   cmd->add_option("--png-slices", args->png_dir, "Also write one PNG per Z layer into this directory");
   cmd->add_option("--method", args->method,

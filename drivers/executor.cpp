@@ -7,6 +7,7 @@
 
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
+#include "drivers/job_restart.hpp"
 #include "drivers/journal.hpp"
 #include "gcode/check.hpp"
 #include "gcode/files.hpp"
@@ -34,6 +35,7 @@ std::string hex(std::uint64_t v) {
 // The program to run and the job it belongs to.
 struct Job {
   bool resumed = false;
+  bool restarted = false;          // resumed at --from-line as a new program (the controller lost it)
   config::Machine machine;
   JournalHeader header;
   std::optional<Journal> journal;
@@ -47,6 +49,11 @@ void open_resumed_job(const JobRequest& request, Job& job) {
   job.header = job.journal->header();
   job.text = gcode::read_text_file(job.header.program);
   job.machine = config::load_machine(request.machine.empty() ? job.header.machine : request.machine);
+  if (request.from_line > 0) {
+    job.restarted = true;
+    job.text = restart_job(*job.journal, job.machine, request.from_line);
+    job.header = job.journal->header();
+  }
   if (!request.transport.empty()) job.header.transport = request.transport;
   job.program = gcode::PostedProgram::from_lines(protocol::program_lines(job.text));
 }
@@ -227,7 +234,8 @@ JobResult stream_job(Job& job, JobOperator& op) {
   const auto begun = Clock::now();
   const StreamCallbacks cb = stream_callbacks(op, actions, job.program.lines, begun);
   StreamOptions options;
-  options.resume = job.resumed;
+  options.resume = job.resumed && !job.restarted;
+  options.resume_host_hold = options.resume && job.journal->progress().held_by_host;
   JobResult result;
   result.stream = stream_program(*transport, job.program.lines, options, cb, &*job.journal);
   result.seconds = seconds_between(begun, Clock::now());

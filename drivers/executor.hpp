@@ -35,6 +35,7 @@ struct JobRequest {
   int rank = 1;           ///< with a plan: which plan, by rank
   std::string job;        ///< job directory; empty: jobs/IDENTITY (first 12 hex digits)
   std::string resume;     ///< job directory to resume
+  unsigned from_line = 0; ///< with `resume`: restart the program there (the controller lost it)
 };
 
 /// The job as it starts streaming.

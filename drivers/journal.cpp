@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <chrono>
 #include <condition_variable>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <mutex>
@@ -22,6 +23,26 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 constexpr const char* kFileName = "journal.jsonl";
+// Space kept aside for the last entries when the disk fills up: released on ENOSPC so the
+// entry that failed, and the note that the host stopped, still get written.
+constexpr const char* kReserveName = "journal.reserve";
+constexpr std::size_t kReserveBytes = 64 * 1024;
+
+// A test hook (docs/drivers.md "Soak run"): HYBRIDCTL_JOURNAL_FULL_AT=BYTES makes every
+// write that would take the journal past BYTES fail with ENOSPC, until the reserve is
+// released (the space it frees lifts the limit by its size).
+std::uint64_t injected_full_at() {
+  const char* v = std::getenv("HYBRIDCTL_JOURNAL_FULL_AT");
+  return v && *v ? std::strtoull(v, nullptr, 10) : 0;
+}
+
+void make_reserve(const fs::path& directory) {
+  const fs::path path = directory / kReserveName;
+  if (fs::exists(path)) return;
+  std::ofstream out(path, std::ios::binary);
+  const std::string block(4096, '\0');
+  for (std::size_t n = 0; n < kReserveBytes && out; n += block.size()) out.write(block.data(), std::streamsize(block.size()));
+}
 
 double seconds_now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -82,7 +103,8 @@ Journal::Journal(fs::path path, int fd, JournalHeader header, JournalProgress pr
 
 Journal::Journal(Journal&& o) noexcept
     : sync_period_s(o.sync_period_s), path_(std::move(o.path_)), fd_(o.fd_), last_sync_(o.last_sync_),
-      header_(std::move(o.header_)), progress_(o.progress_), background_(std::move(o.background_)) {
+      header_(std::move(o.header_)), progress_(o.progress_), background_(std::move(o.background_)),
+      write_failed_(o.write_failed_), bytes_written_(o.bytes_written_) {
   o.fd_ = -1;
 }
 
@@ -96,6 +118,8 @@ Journal& Journal::operator=(Journal&& o) noexcept {
     header_ = std::move(o.header_);
     progress_ = o.progress_;
     background_ = std::move(o.background_);
+    write_failed_ = o.write_failed_;
+    bytes_written_ = o.bytes_written_;
     o.fd_ = -1;
   }
   return *this;
@@ -121,6 +145,7 @@ Journal Journal::create(const fs::path& directory, const JournalHeader& header) 
   if (fd < 0)
     throw InputError(path.string() + ": cannot start a journal: " + std::strerror(errno) +
                      (errno == EEXIST ? " (a job directory holds one job: resume it with --resume, or choose another)" : ""));
+  make_reserve(directory);
   Journal j(path, fd, header, {});
   const json h = {{"journal", "hybridctl-job"}, {"version", 1},          {"program", header.program},
                   {"identity", hex64(header.identity)},                  {"lines", header.lines},
@@ -168,6 +193,22 @@ Journal Journal::open(const fs::path& directory) {
         progress.last_chunk = j.at("chunk").get<std::uint32_t>();
         progress.through_line = j.at("through_line").get<std::uint32_t>();
         progress.executed_line = j.at("executed_line").get<std::uint32_t>();
+        progress.held_by_host = false;
+      } else if (j.contains("lost")) {
+        progress.lost = true;
+        progress.lost_executed_line = j.at("executed_line").get<std::uint32_t>();
+        progress.lost_accepted_line = j.at("accepted_line").get<std::uint32_t>();
+      } else if (j.contains("restart")) {
+        const json& r = j.at("restart");
+        header.program = r.at("program").get<std::string>();
+        header.identity = std::stoull(r.at("identity").get<std::string>(), nullptr, 16);
+        header.lines = r.at("lines").get<std::uint32_t>();
+        header.restart_from_line = r.at("from_line").get<std::uint32_t>();
+        header.restart_preamble_lines = r.at("preamble_lines").get<std::uint32_t>();
+        header.original_program = r.at("original_program").get<std::string>();
+        progress = {};
+      } else if (j.contains("held_by_host")) {
+        progress.held_by_host = true;
       } else if (j.contains("completed")) {
         progress.completed = true;
         progress.executed_line = j.at("completed").get<std::uint32_t>();
@@ -181,19 +222,34 @@ Journal Journal::open(const fs::path& directory) {
   if (number == 0) throw InputError(path.string() + ": empty journal; expected a header line");
   const int fd = ::open(path.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
   if (fd < 0) throw InputError(path.string() + ": cannot append: " + std::strerror(errno));
-  return Journal(path, fd, header, progress);
+  make_reserve(directory);
+  Journal j(path, fd, header, progress);
+  j.bytes_written_ = fs::file_size(path);
+  return j;
 }
 
 void Journal::append(const std::string& line, bool sync) {
   const std::string text = line + "\n";
   std::size_t done = 0;
+  static const std::uint64_t full_at = injected_full_at();
   while (done < text.size()) {
-    const ssize_t n = ::write(fd_, text.data() + done, text.size() - done);
+    const bool injected = full_at && !write_failed_ && bytes_written_ + (text.size() - done) > full_at;
+    const ssize_t n = injected ? (errno = ENOSPC, -1) : ::write(fd_, text.data() + done, text.size() - done);
     if (n < 0) {
       if (errno == EINTR) continue;
+      if ((errno == ENOSPC || errno == EDQUOT) && !write_failed_) {
+        // The disk is full: free the reserve and write this entry (a chunk the controller
+        // took must not go unrecorded); from now on the journal is not writable and the
+        // streamer stops sending.
+        write_failed_ = true;
+        std::error_code ec;
+        fs::remove(path_.parent_path() / kReserveName, ec);
+        continue;
+      }
       throw std::runtime_error(path_.string() + ": cannot write the journal: " + std::strerror(errno));
     }
     done += std::size_t(n);
+    bytes_written_ += std::uint64_t(n);
   }
   if (sync) {
     ::fsync(fd_);
@@ -213,6 +269,35 @@ void Journal::acknowledged(std::uint32_t chunk, std::uint32_t through_line, std:
     background_->request();
     last_sync_ = now;
   }
+}
+
+void Journal::lost(const std::string& kind, const std::string& what, std::uint32_t executed_line,
+                   std::uint32_t accepted_line) {
+  progress_.lost = true;
+  progress_.lost_executed_line = executed_line;
+  progress_.lost_accepted_line = accepted_line;
+  append(json{{"lost", kind}, {"what", what}, {"executed_line", executed_line}, {"accepted_line", accepted_line}}.dump(), true);
+}
+
+void Journal::restarted(const std::string& program, std::uint64_t identity, std::uint32_t lines, std::uint32_t from_line,
+                        std::uint32_t preamble_lines, const std::string& original_program) {
+  header_.original_program = original_program;
+  header_.program = program;
+  header_.identity = identity;
+  header_.lines = lines;
+  header_.restart_from_line = from_line;
+  header_.restart_preamble_lines = preamble_lines;
+  progress_ = {};
+  append(json{{"restart", {{"program", program}, {"identity", hex64(identity)}, {"lines", lines}, {"from_line", from_line},
+                           {"preamble_lines", preamble_lines},
+                           {"original_program", original_program}}}}
+             .dump(),
+         true);
+}
+
+void Journal::held_by_host(const std::string& why) {
+  progress_.held_by_host = true;
+  append(json{{"held_by_host", why}}.dump(), true);
 }
 
 void Journal::note(const std::string& event) { append(json{{"note", event}}.dump(), false); }

@@ -23,6 +23,11 @@ struct JournalHeader {
   std::string machine;    // machine file
   std::string transport;  // URI
   std::string source;     // what the program was made from (plan.json and rank), for people
+  // After `run --resume --from-line N`: the program above is the restart (a preamble, then
+  // the original's lines N..end; docs/drivers.md "Controller power loss").
+  std::uint32_t restart_from_line = 0;
+  std::uint32_t restart_preamble_lines = 0;
+  std::string original_program;  // the program the restart was made from
 };
 
 struct JournalProgress {
@@ -30,6 +35,13 @@ struct JournalProgress {
   std::uint32_t through_line = 0;
   std::uint32_t executed_line = 0;  // last executed line seen in a status
   bool completed = false;
+  // The controller lost the program (docs/drivers.md "Controller power loss"): what it had
+  // reported executed and accepted then.
+  bool lost = false;
+  std::uint32_t lost_executed_line = 0, lost_accepted_line = 0;
+  // The host held the feed and stopped (the journal could not be written): a resume
+  // sends RESUME once the controller's buffer is refilled.
+  bool held_by_host = false;
 };
 
 class Journal {
@@ -57,6 +69,18 @@ class Journal {
   // Free-form events (reconnects, reboots, alarms), not fsync'd on their own.
   void note(const std::string& event);
   void completed(std::uint32_t executed_line);
+  // The controller lost the program: synced at once.
+  void lost(const std::string& kind, const std::string& what, std::uint32_t executed_line, std::uint32_t accepted_line);
+  // The job goes on as a new program (`run --resume --from-line`): the header's program,
+  // identity and line count become the restart's; synced at once.
+  void restarted(const std::string& program, std::uint64_t identity, std::uint32_t lines, std::uint32_t from_line,
+                 std::uint32_t preamble_lines, const std::string& original_program);
+  // The host held the feed because it cannot record what it sends (the disk is full).
+  void held_by_host(const std::string& why);
+  // Whether the journal can still record: false after a write failed (ENOSPC). The entry
+  // that failed was written after freeing the journal's reserve (journal.reserve, made
+  // at create), so nothing sent goes unrecorded; the streamer then stops sending.
+  bool writable() const { return !write_failed_; }
 
  private:
   struct BackgroundSync;
@@ -70,6 +94,8 @@ class Journal {
   JournalHeader header_;
   JournalProgress progress_;
   std::unique_ptr<BackgroundSync> background_;  // made at the first acknowledged range
+  bool write_failed_ = false;
+  std::uint64_t bytes_written_ = 0;  // for the injected disk-full limit (journal.cpp)
 };
 
 }  // namespace hybridctl::drivers

@@ -38,12 +38,33 @@ bool program_fault(AlarmCode a) {
          a == AlarmCode::GcodeError || a == AlarmCode::SpindleDepositionConflict || a == AlarmCode::ProgramIdentityMismatch;
 }
 
+// Thrown from a status read that shows the controller lost the program; caught in run().
+struct Lost {
+  ControllerLoss loss;
+};
+
 class Session {
  public:
   Session(Transport& t, std::span<const std::string> lines, const StreamOptions& o, const StreamCallbacks& cb, Journal* j)
       : t_(t), lines_(lines), options_(o), cb_(cb), journal_(j), identity_(protocol::program_identity(lines)) {}
 
   StreamResult run() {
+    try {
+      stream();
+    } catch (const Lost& l) {
+      result_.loss = l.loss;
+      result_.stopped_because = describe_loss(l.loss, journal_ ? journal_->file().parent_path().string() : std::string());
+      if (journal_) journal_->lost(std::string(to_string(l.loss.kind)), l.loss.what, l.loss.executed_line, l.loss.accepted_line);
+    }
+    result_.final_status = status_;
+    // After a loss the new controller's status says nothing of this program's lines.
+    if (result_.loss) result_.final_status.last_executed_line = result_.loss->executed_line;
+    if (journal_ && result_.completed) journal_->completed(status_.last_executed_line);
+    return result_;
+  }
+
+ private:
+  void stream() {
     status_ = t_.read_status();
     boot_ = status_.boot_count;
     seq_ = status_.command_seq;
@@ -81,17 +102,66 @@ class Session {
         reread = true;
       }
     }
-    result_.final_status = status_;
-    if (journal_ && result_.completed) journal_->completed(status_.last_executed_line);
-    return result_;
   }
 
- private:
+  // What this host knows of the controller, from every status of our program.
+  void know(const protocol::Status& s) {
+    if (known_.identity == 0 || s.identity != known_.identity) {
+      known_.boot = s.boot_count;
+      return;
+    }
+    if (s.boot_count != known_.boot) known_.accepted_chunk = s.last_accepted_chunk;  // the queue went with the boot
+    known_.boot = s.boot_count;
+    known_.executed_line = std::max(known_.executed_line, s.last_executed_line);
+    known_.accepted_chunk = std::max(known_.accepted_chunk, s.last_accepted_chunk);
+    if (s.state != ControllerState::Idle) known_.started = true;
+  }
+  void program_is_ours() {
+    known_.identity = identity_;
+    known_.boot = status_.boot_count;
+    known_.accepted_chunk = status_.last_accepted_chunk;
+    known_.executed_line = std::max(known_.executed_line, status_.last_executed_line);
+    if (status_.next_line > 0) known_.accepted_line = std::max(known_.accepted_line, status_.next_line - 1);
+    known_.started = status_.state != ControllerState::Idle;
+  }
+  // Every few seconds while the controller waits on someone else: say what for.
+  void say_what_we_wait_for() {
+    std::string what;
+    if (status_.state == ControllerState::FeedHold && !held_by_us_ && !host_hold_)
+      what = "the controller is in FEED_HOLD, held at the machine after line " + std::to_string(status_.last_executed_line) +
+             ": cycle start (RESUME) there goes on";
+    if (what.empty()) {
+      waiting_since_.reset();
+      return;
+    }
+    const auto now = Clock::now();
+    if (!waiting_since_) waiting_since_ = now - std::chrono::hours(1);
+    if (std::chrono::duration<double>(now - *waiting_since_).count() < options_.waiting_note_period_s) return;
+    waiting_since_ = now;
+    note("waiting: " + what);
+  }
+  // The journal could not record (the disk is full): send nothing more, hold the feed
+  // where the machine is, and stop; `run --resume` goes on once there is space.
+  void stop_unrecorded() {
+    command(CommandCode::FeedHold);
+    if (journal_) journal_->held_by_host("the journal cannot be written (disk full)");
+    result_.stopped_because = "the journal " + (journal_ ? journal_->file().string() : std::string()) +
+                              " cannot be written (disk full): the feed is held after line " +
+                              std::to_string(status_.last_executed_line) + "; every chunk sent is recorded through line " +
+                              std::to_string(known_.accepted_line) + ". Free space, then hybridctl run --resume " +
+                              (journal_ ? journal_->file().parent_path().string() : std::string("JOB"));
+  }
+
   void note(const std::string& s) {
     if (cb_.note) cb_.note(s);
     if (journal_) journal_->note(s);
   }
   void seen(const protocol::Status& s) {
+    if (auto loss = detect_loss(known_, s, std::uint32_t(lines_.size()))) {
+      status_ = s;
+      throw Lost{*loss};
+    }
+    know(s);
     status_ = s;
     if (cb_.status) cb_.status(s);
     if (s.boot_count != boot_) {
@@ -121,18 +191,31 @@ class Session {
     const ControllerState st = status_.state;
     const bool free = st == ControllerState::Idle || st == ControllerState::Completed || st == ControllerState::Aborted;
     if (options_.resume) {
+      if (status_.identity == 0 && journal_ && journal_->progress().through_line > 0) {
+        // The journal says lines went there; the controller has none of them.
+        known_.executed_line = journal_->progress().executed_line;
+        known_.accepted_line = journal_->progress().through_line;
+        throw Lost{{ControllerLoss::Kind::NewBootWithoutProgram,
+                    "the controller holds no program (boot " + std::to_string(status_.boot_count) + ", state " +
+                        std::string(protocol::to_string(st)) + ") while the journal records lines 1.." +
+                        std::to_string(known_.accepted_line) + " accepted",
+                    known_.executed_line, known_.accepted_line, std::uint32_t(lines_.size())}};
+      }
       if (!ours)
         throw InputError("the controller holds program " + hex64(status_.identity) + ", not this job's " + hex64(identity_) +
                          ": refusing to resume into another program");
       note("resuming: the controller executed through line " + std::to_string(status_.last_executed_line) + " of " +
            std::to_string(lines_.size()) + ", state " + std::string(protocol::to_string(st)));
       started_ = st != ControllerState::Idle;
+      held_by_us_ = options_.resume_host_hold && st == ControllerState::FeedHold;
+      program_is_ours();
       return;
     }
     if (ours && !free) {
       // Our own program, interrupted (a host restart without --resume): carry on.
       note("the controller is already running this program: continuing at line " + std::to_string(status_.next_line));
       started_ = true;
+      program_is_ours();
       return;
     }
     if (!free)
@@ -141,6 +224,7 @@ class Session {
     command(CommandCode::SetProgram);
     if (status_.identity != identity_)
       throw InputError("the controller did not take the program: " + std::string(protocol::to_string(status_.command_result)));
+    program_is_ours();
   }
 
   void heartbeat() {
@@ -176,8 +260,10 @@ class Session {
       const ResultCode r = ours_written ? status_.chunk_result : ResultCode::None;
       if (r == ResultCode::Accepted) {
         ++result_.counters.chunks_accepted;
+        known_.accepted_line = c.first_line + c.line_count - 1;
         if (journal_) journal_->acknowledged(c.seq, c.first_line + c.line_count - 1, status_.last_executed_line);
         more_to_send_ = sent + 1 == kChunksPerRound;
+        if (journal_ && !journal_->writable()) return;
       } else if (r == ResultCode::Duplicate) {
         ++result_.counters.duplicates;
       } else if (r == ResultCode::BufferFull) {
@@ -203,10 +289,16 @@ class Session {
 
   // Follows the controller's state; true when the stream is over.
   bool decide() {
+    if (journal_ && !journal_->writable()) {
+      stop_unrecorded();
+      return true;
+    }
+    say_what_we_wait_for();
     if (status_.identity != identity_) {
       // The controller lost the program (a reboot without a started program): set it again.
       if (status_.identity == 0 && status_.state == ControllerState::Idle) {
         command(CommandCode::SetProgram);
+        program_is_ours();
         return false;
       }
       result_.stopped_because = "the controller now holds another program (" + hex64(status_.identity) + ")";
@@ -301,6 +393,8 @@ class Session {
   ResultCode refused_result_ = ResultCode::None;
   int refusals_ = 0;
   StreamResult result_;
+  StreamKnowledge known_;
+  std::optional<Clock::time_point> waiting_since_;
 };
 
 }  // namespace

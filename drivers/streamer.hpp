@@ -11,11 +11,13 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "protocol/messages.hpp"
+#include "drivers/controller_loss.hpp"
 #include "drivers/transport.hpp"
 
 namespace hybridctl::drivers {
@@ -45,6 +47,12 @@ struct StreamOptions {
   double poll_period_s = 0.002;     // status polling when there is nothing to send
   // Resume: the controller must hold this very program (its identity); never SET_PROGRAM.
   bool resume = false;
+  // Resume after the host held the feed itself (JournalProgress::held_by_host): RESUME
+  // once the controller's buffer is refilled.
+  bool resume_host_hold = false;
+  // While the controller waits on someone (a feed hold at the machine), a note saying so
+  // this often.
+  double waiting_note_period_s = 5.0;
   // A request the transport gave up on (after its own resends) costs a pause (100 ms,
   // doubling up to 2 s) and a fresh status read; this many in a row with no progress in
   // between (no chunk taken, no line executed) end the stream (TransportError).
@@ -66,6 +74,9 @@ struct StreamResult {
   bool completed = false;
   protocol::Status final_status;
   std::string stopped_because;  // when not completed: the alarm or the decision that ended it
+  // The controller lost the program (docs/drivers.md "Controller power loss"): the
+  // stream stopped at the first status that showed it; stopped_because says what to do.
+  std::optional<ControllerLoss> loss;
   StreamCounters counters;
 };
 

@@ -8,6 +8,7 @@
 #include "common/error.hpp"
 #include "geometry/vdb_file.hpp"
 #include "geometry/voxelize.hpp"
+#include "planner/memory_estimate.hpp"
 
 namespace hybridctl::planner {
 namespace {
@@ -30,37 +31,6 @@ class PhaseClock {
   std::vector<std::pair<std::string, double>>& out_;
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
-
-Box3 grown(const Box3& b, double by) {
-  return {{b.min.x - by, b.min.y - by, b.min.z - by}, {b.max.x + by, b.max.y + by, b.max.z + by}};
-}
-
-Box3 box_hull(const Box3& a, const Box3& b) {
-  return {{std::min(a.min.x, b.min.x), std::min(a.min.y, b.min.y), std::min(a.min.z, b.min.z)},
-          {std::max(a.max.x, b.max.x), std::max(a.max.y, b.max.y), std::max(a.max.z, b.max.z)}};
-}
-
-// The region planning looks at: the design with room for overfill and the tolerance
-// band, and every raw stock.
-Box3 planning_region(const config::Machine& m, const Box3& design, double tolerance) {
-  double reach = tolerance;
-  for (const auto& head : m.heads) reach = std::max(reach, std::max(head.bead.width, head.bead.height));
-  Box3 region = grown(design, reach);
-  const geometry::Vec3 c{(design.min.x + design.max.x) / 2, (design.min.y + design.max.y) / 2,
-                         (design.min.z + design.max.z) / 2};
-  for (const auto& s : m.raw_stocks) {
-    if (s.kind == config::RawStock::Kind::Box) {
-      region = box_hull(region, {{design.min.x - s.margin[0], design.min.y - s.margin[1], design.min.z - s.margin[2]},
-                                 {design.max.x + s.margin[0], design.max.y + s.margin[1], design.max.z + s.margin[2]}});
-    } else {
-      const double r = s.bar_diameter / 2, l = s.bar_length / 2;
-      const geometry::Vec3 half{s.bar_axis == config::Axis::X ? l : r, s.bar_axis == config::Axis::Y ? l : r,
-                                s.bar_axis == config::Axis::Z ? l : r};
-      region = box_hull(region, {{c.x - half.x, c.y - half.y, c.z - half.z}, {c.x + half.x, c.y + half.y, c.z + half.z}});
-    }
-  }
-  return region;
-}
 
 Solid load_primitive_file(const PrimitiveFile& f, const Lattice& lattice) {
   const std::string ext = std::filesystem::path(f.path).extension().string();
@@ -199,6 +169,8 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
   r.sliver_threshold = options.sliver_threshold >= 0 ? options.sliver_threshold : defaults.sliver_threshold;
   const int top_k = options.top_k > 0 ? options.top_k : defaults.top_k;
 
+  // Before anything large is allocated: a grid over the budget is an input error.
+  check_planning_memory(geometry::bounds(part), machine, h, r.tolerance, options.memory_budget, part_name);
   voxelize_design(part, part_name, machine, h, progress, r);
   clock.lap("voxelize");
   add_primitives(machine, options.extra_primitives, progress, r);

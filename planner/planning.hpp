@@ -32,6 +32,8 @@ struct PlanningOptions {
   int max_uses = 1;
   std::int64_t max_expansions = 5'000'000;
   std::vector<PrimitiveFile> extra_primitives;
+  // Bytes planning may take (planner/memory_estimate.hpp); 0: half the physical memory.
+  std::uint64_t memory_budget = 0;
   // Progress: a phase name and a fraction of it done.
   std::function<void(const std::string& phase, double fraction)> progress;
 };

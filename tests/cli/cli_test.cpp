@@ -6,7 +6,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstring>
+#include <regex>
 #include "shell.hpp"
 
 #include <filesystem>
@@ -253,6 +255,61 @@ TEST_F(Cli, GcodeCheckArgumentAndFileErrors) {
   EXPECT_NE(missing.err.find("nope.ngc: cannot read: No such file or directory"), std::string::npos) << missing.err;
   const Outcome bad_machine = run({"gcode", "check", file.string(), "--machine", file.string()});
   EXPECT_EQ(bad_machine.exit_code, 3);
+}
+
+}  // namespace
+
+namespace {
+
+// Range errors say the range as a person writes it, in one short line.
+TEST_F(Cli, RangeErrorsSayTheRangeInWords) {
+  const Outcome zero = run({"plan", kBracket, "--machine", kMachine, "--voxel", "0"});
+  EXPECT_EQ(zero.exit_code, 2);
+  EXPECT_NE(zero.err.find("--voxel must be greater than 0 (got 0)"), std::string::npos) << zero.err;
+  EXPECT_LT(zero.err.size(), 200u) << zero.err;
+  const Outcome reuse = run({"plan", kBracket, "--machine", kMachine, "--reuse", "9"});
+  EXPECT_NE(reuse.err.find("--reuse must be between 1 and 8 (got 9)"), std::string::npos) << reuse.err;
+  const Outcome tolerance = run({"plan", kBracket, "--machine", kMachine, "--tolerance", "-1"});
+  EXPECT_NE(tolerance.err.find("--tolerance must be at least 0 (got -1)"), std::string::npos) << tolerance.err;
+  const Outcome scale = run({"sim", "serve", "--machine", kMachine, "--time-scale", "2e6"});
+  EXPECT_NE(scale.err.find("--time-scale must be between 0 and 1000000 (got 2e6)"), std::string::npos) << scale.err;
+}
+
+// Peak resident memory of a child command, from /usr/bin/time -v (KiB).
+long peak_rss_kib(const std::string& err) {
+  const auto at = err.find("Maximum resident set size (kbytes): ");
+  return at == std::string::npos ? -1 : std::stol(err.substr(at + 36));
+}
+
+// A voxel far too small for the memory is an input error found before any grid: exit 3
+// at once, with the estimate, the budget and a voxel that fits, and no large allocation.
+TEST_F(Cli, AVoxelTooSmallForTheMemoryIsRefusedBeforeAllocating) {
+  if (std::system("test -x /usr/bin/time") != 0) GTEST_SKIP() << "/usr/bin/time is missing";
+  const auto timed = [&](std::vector<std::string> args) {
+    std::string cmd = "/usr/bin/time -v " + quote(HYBRIDCTL_EXE);
+    for (const auto& a : args) cmd += " " + quote(a);
+    return hybridctl::cli_testing::run_shell(cmd, dir_);
+  };
+  const Outcome baseline = timed({"machine", "check", kMachine});
+  const auto started = std::chrono::steady_clock::now();
+  const Outcome r = timed({"plan", kBracket, "--machine", kMachine, "--voxel", "0.01"});
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  EXPECT_EQ(r.exit_code, 3) << r.err;
+  EXPECT_LT(seconds, 20.0);
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.err, m,
+                                std::regex(R"(needs about ([0-9.]+) GiB of memory, over the budget of ([0-9.]+) GiB .*--voxel ([0-9.]+) or larger fits)")))
+      << r.err;
+  EXPECT_GT(std::stod(m[1]), std::stod(m[2]));
+  EXPECT_LE(peak_rss_kib(r.err), peak_rss_kib(baseline.err) + 16 * 1024) << r.err << baseline.err;
+  // A small budget is said in its own units.
+  const Outcome small = run({"voxelize", kBracket, "--voxel", "0.05", "--memory-budget", "20M", "-o", (dir_ / "x.vdb").string()});
+  EXPECT_EQ(small.exit_code, 3) << small.err;
+  EXPECT_NE(small.err.find("over the budget of 20.0 MiB"), std::string::npos) << small.err;
+  EXPECT_FALSE(fs::exists(dir_ / "x.vdb"));
+  const Outcome bad = run({"plan", kBracket, "--machine", kMachine, "--memory-budget", "lots"});
+  EXPECT_EQ(bad.exit_code, 3);
+  EXPECT_NE(bad.err.find("expected a size greater than 0 such as 8G"), std::string::npos) << bad.err;
 }
 
 }  // namespace

@@ -367,3 +367,93 @@ TEST_F(Run, DryRunComparesAsBuiltWithAsPlanned) {
 }
 
 }  // namespace
+
+namespace {
+
+// A `sim serve` on a given port (0: any), with its own line log; returns the port.
+int start_sim(std::unique_ptr<Background>& sim, const fs::path& dir, const std::string& name, int port, const std::string& time_scale,
+              const std::string& stock) {
+  const std::vector<std::string> args = {"sim", "serve", "--machine", kMachine, "--stock", stock, "--line-log",
+                                         (dir / (name + ".ngc")).string(), "--modbus", "tcp://127.0.0.1:" + std::to_string(port),
+                                         "--time-scale", time_scale, "--exit-when-done"};
+  sim = std::make_unique<Background>(command(args), dir, name);
+  for (int i = 0; i < kStartupPolls; ++i) {
+    std::smatch m;
+    const std::string out = slurp(dir / (name + ".out"));
+    if (std::regex_search(out, m, std::regex("listening modbus-tcp 127\\.0\\.0\\.1:([0-9]+)")) && out.find("ready") != std::string::npos)
+      return std::stoi(m[1]);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ADD_FAILURE() << slurp(dir / (name + ".err"));
+  return 0;
+}
+
+// The last executed line the journal recorded.
+std::uint32_t journal_executed(const fs::path& journal) {
+  const std::string j = slurp(journal);
+  const auto at = j.rfind("\"executed_line\":");
+  return at == std::string::npos ? 0 : std::uint32_t(std::stoul(j.substr(at + 16)));
+}
+
+// A controller power cycle mid-program: the simulator killed (SIGKILL) at about line 3000
+// and a new one started on the same port, with no program and no safe point. The host
+// stops at the first status of the new controller, says what ran, what may have, and what
+// to do; `run --resume --from-line` then runs the rest once.
+TEST_F(Run, AControllerPowerLossStopsTheHostWhichSaysWhatRanAndResumesFromTheSafePoint) {
+  std::unique_ptr<Background> first, second;
+  const int port = start_sim(first, dir_, "sim1", 0, "200", plan().string());
+  ASSERT_GT(port, 0);
+  const std::string uri = "modbus-tcp://127.0.0.1:" + std::to_string(port);
+  Background host(command({"run", plan().string(), "--machine", kMachine, "--transport", uri, "--job", (dir_ / "job").string(), "--yes"}),
+                  dir_, "host");
+  for (int i = 0; i < 1200 && journal_executed(dir_ / "job" / "journal.jsonl") < 3000; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_GE(journal_executed(dir_ / "job" / "journal.jsonl"), 3000u) << slurp(dir_ / "host.err").substr(0, 2000);
+  ::kill(first->pid, SIGKILL);
+  first->wait_exit(5);
+  ASSERT_GT(start_sim(second, dir_, "sim2", port, "0", plan().string()), 0);
+  // The documented bound (docs/drivers.md): the first status read once the controller
+  // answers again, at most one reconnect backoff step (2 s) after it is back.
+  const auto back = std::chrono::steady_clock::now();
+  host.wait_exit(10);
+  EXPECT_FALSE(host.alive()) << "the host did not stop: " << slurp(dir_ / "host.err").substr(0, 2000);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - back).count(), 5.0);
+  int status = 0;
+  (void)::waitpid(host.pid, &status, WNOHANG);  // not our child (started by the shell): read its report instead
+  const std::string out = slurp(dir_ / "host.out");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex(R"(controller lost the program: .*\n  executed    lines 1\.\.(\d+), as the controller reported them\n  uncertain   lines (\d+)\.\.(\d+) )")))
+      << out << slurp(dir_ / "host.err").substr(0, 2000);
+  const std::uint32_t executed = std::stoul(m[1]), accepted = std::stoul(m[3]);
+  EXPECT_EQ(std::stoul(m[2]), executed + 1);
+  ASSERT_TRUE(std::regex_search(out, m, std::regex(R"(hybridctl run --resume (\S+) --from-line (\d+))"))) << out;
+  EXPECT_EQ(m[1], (dir_ / "job").string());
+  const std::uint32_t from = std::stoul(m[2]);
+  EXPECT_EQ(from, executed + 1);
+  EXPECT_NE(slurp(dir_ / "job" / "journal.jsonl").find("\"lost\""), std::string::npos);
+  // The first controller ran no line past the uncertain span (its log is what it flushed).
+  const std::string program = slurp(dir_ / "job" / "program.ngc"), log1 = slurp(dir_ / "sim1.ngc.tmp");
+  EXPECT_LE(std::count(log1.begin(), log1.end(), '\n'), long(accepted));
+  EXPECT_EQ(program.compare(0, log1.size(), log1), 0) << "the first controller's log is a prefix of the program";
+
+  // Lines before the safe point would run twice; lines after the uncertain span were never sent.
+  EXPECT_EQ(run({"run", "--resume", (dir_ / "job").string(), "--from-line", std::to_string(executed), "--yes"}), 3);
+  EXPECT_NE(slurp(dir_ / "run.err").find("not a safe point"), std::string::npos) << slurp(dir_ / "run.err");
+  EXPECT_EQ(run({"run", "--resume", (dir_ / "job").string(), "--from-line", std::to_string(accepted + 2), "--yes"}), 3);
+  EXPECT_EQ(run({"run", "--resume", (dir_ / "job").string(), "--from-line", "99999999", "--yes"}), 3);
+  ASSERT_EQ(run({"run", "--resume", (dir_ / "job").string(), "--from-line", std::to_string(from), "--yes"}), 0)
+      << slurp(dir_ / "run.err").substr(0, 3000);
+  second->wait_exit(10);
+  // The new boot ran the restart (its preamble, then lines N..end), each line once.
+  const fs::path restart = dir_ / "job" / ("program-from-line-" + std::to_string(from) + ".ngc");
+  const std::string log2 = slurp(dir_ / "sim2.ngc"), restart_text = slurp(restart);
+  EXPECT_TRUE(log2 == restart_text) << log2.size() << " vs " << restart_text.size();
+  std::size_t at = 0;
+  for (std::uint32_t l = 1; l < from; ++l) at = program.find('\n', at) + 1;
+  const std::string rest = program.substr(at);
+  ASSERT_GE(log2.size(), rest.size());
+  EXPECT_TRUE(log2.compare(log2.size() - rest.size(), rest.size(), rest) == 0) << "the new boot's log ends with lines N..end";
+  EXPECT_EQ(restart_text.rfind("(restart at line " + std::to_string(from) + ":", 0), 0u);
+}
+
+}  // namespace
