@@ -14,17 +14,14 @@
 #include <utility>
 #include <vector>
 
+#include "common/number_text.hpp"
 #include "config/diagnostic.hpp"
 #include "config/machine.hpp"
 #include "config/yaml_reader.hpp"
 
 namespace hybridctl::config::detail {
 
-inline std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
+inline std::string fmt(double v) { return shortest_number(v); }
 
 inline std::string line_of(const YAML::Mark& m) { return std::to_string(m.is_null() ? 1 : m.line + 1); }
 

@@ -3,15 +3,13 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "common/number_text.hpp"
+
 namespace hybridctl::config {
 
 namespace {
 
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
+std::string fmt(double v) { return shortest_number(v); }
 
 std::string range(const Range& r) { return fmt(r.min) + ".." + fmt(r.max); }
 
@@ -105,4 +103,5 @@ std::string summarize(const Machine& m) {
   return out.text;
 }
 
-}  // namespace hybridctl::config
+}  // namespace hybridctl::config#include "common/number_text.hpp"
+

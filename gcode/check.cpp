@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "common/number_text.hpp"
+
 namespace hybridctl::gcode {
 
 namespace {
@@ -11,15 +13,7 @@ namespace {
 constexpr double kTwoPi = 2.0 * M_PI;
 constexpr double kFullCircle = 1e-9;  ///< mm: start and end this close make a full circle
 
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4f", v);
-  std::string s = buf;
-  while (!s.empty() && s.back() == '0') s.pop_back();
-  if (!s.empty() && s.back() == '.') s.pop_back();
-  if (s == "-0") s = "0";
-  return s;
-}
+std::string fmt(double v) { return trimmed_number(v, 4); }
 
 double get(const Vec3& v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
 double& get(Vec3& v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
@@ -395,3 +389,4 @@ std::string CheckReport::str() const {
 }
 
 }  // namespace hybridctl::gcode
+

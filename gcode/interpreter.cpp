@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "common/number_text.hpp"
 #include "gcode/interpreter_steps.hpp"
 
 namespace hybridctl::gcode {
@@ -18,15 +19,7 @@ constexpr double kMaxNumberWord = 99999;
 
 bool number_word(double v) { return v >= 0 && v <= kMaxNumberWord && v == std::nearbyint(v); }
 
-std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4f", v);
-  std::string s = buf;
-  while (!s.empty() && s.back() == '0') s.pop_back();
-  if (!s.empty() && s.back() == '.') s.pop_back();
-  if (s == "-0") s = "0";
-  return s;
-}
+std::string fmt(double v) { return trimmed_number(v, 4); }
 
 }  // namespace detail
 

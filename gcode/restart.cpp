@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <string_view>
 
+#include "common/number_text.hpp"
 #include "common/error.hpp"
 #include "gcode/interpreter.hpp"
 
@@ -10,14 +11,7 @@ namespace hybridctl::gcode {
 namespace {
 
 // Enough digits for a micrometre (or a tenth of a thou), no trailing zeros.
-std::string number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4f", v);
-  std::string s = buf;
-  while (s.back() == '0') s.pop_back();
-  if (s.back() == '.') s.pop_back();
-  return s == "-0" ? "0" : s;
-}
+std::string number(double v) { return trimmed_number(v, 4); }
 
 // The lines that bring a freshly booted controller to `s`, the modal state after the
 // restart line's predecessor. Motion last: retract to the top of Z (machine frame), set

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "common/number_text.hpp"
 #include "common/error.hpp"
 #include "geometry/vdb_file.hpp"
 
@@ -37,11 +38,7 @@ json atom_ids(const AtomSet& set, int atoms) {
   return ids;
 }
 
-std::string fixed(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
+std::string fixed(double v, int digits) { return fixed_number(v, digits); }
 
 }  // namespace
 

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/number_text.hpp"
 #include "instruments/bead.hpp"
 #include "toolpaths/setup_frame.hpp"
 #include "toolpaths/slices.hpp"
@@ -30,11 +31,7 @@ struct Vec2 {
   double x = 0, y = 0;
 };
 
-std::string mm(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3f", v);
-  return buf;
-}
+std::string mm(double v) { return fixed_number(v, 3); }
 
 // A polyline of deposition at one height.
 struct Pass {

@@ -22,17 +22,10 @@
 #include <vector>
 
 #include "config/machine.hpp"
-#include "gcode/toolpath.hpp"
+#include "toolpaths/toolpath.hpp"
 #include "geometry/solid.hpp"
 
 namespace hybridctl::toolpaths {
-
-// The dialect-neutral toolpath model these generators fill in (gcode/toolpath.hpp).
-using gcode::ActionProgram;
-using gcode::MoveKind;
-using gcode::PathMove;
-using gcode::Process;
-using gcode::Toolpath;
 
 // Where a layer's contour (a pass along the region's edge, half a bead inside it) goes.
 enum class ContourPass {

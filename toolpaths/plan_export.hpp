@@ -17,17 +17,10 @@
 #include "toolpaths/deposition_path.hpp"
 #include "toolpaths/pocket_path.hpp"
 #include "gcode/post.hpp"
-#include "gcode/toolpath.hpp"
+#include "toolpaths/toolpath.hpp"
 #include "planner/plan_file.hpp"
 
 namespace hybridctl::toolpaths {
-
-// The dialect-neutral toolpath model these generators fill in (gcode/toolpath.hpp).
-using gcode::ActionProgram;
-using gcode::MoveKind;
-using gcode::PathMove;
-using gcode::Process;
-using gcode::Toolpath;
 
 struct ExportOptions {
   DepositionOptions deposition;

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/number_text.hpp"
 #include "geometry/morphology.hpp"
 #include "instruments/cutter.hpp"
 #include "toolpaths/pocket_builder.hpp"
@@ -19,11 +20,7 @@
 namespace hybridctl::toolpaths {
 namespace pocket {
 
-std::string mm(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3f", v);
-  return buf;
-}
+std::string mm(double v) { return fixed_number(v, 3); }
 
 void PocketBuilder::move(MoveKind kind, Vec3 to, double feed, bool cutting, std::string comment) {
   if (to == at_ && started_) return;

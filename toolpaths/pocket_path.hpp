@@ -20,17 +20,10 @@
 #include <optional>
 
 #include "config/machine.hpp"
-#include "gcode/toolpath.hpp"
+#include "toolpaths/toolpath.hpp"
 #include "geometry/solid.hpp"
 
 namespace hybridctl::toolpaths {
-
-// The dialect-neutral toolpath model these generators fill in (gcode/toolpath.hpp).
-using gcode::ActionProgram;
-using gcode::MoveKind;
-using gcode::PathMove;
-using gcode::Process;
-using gcode::Toolpath;
 
 enum class PocketStrategy {
   Zigzag,   // rows at step_over (direction per `raster`), plus an edge pass per `wall_pass`
