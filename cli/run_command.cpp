@@ -7,6 +7,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <iostream>
 #include <memory>
 
@@ -48,6 +49,18 @@ bool ask(const std::string& question) {
   return !answer.empty() && (answer[0] == 'y' || answer[0] == 'Y');
 }
 
+// What a stopped controller waits for, for the status line ("" while it runs).
+std::string waiting_for(const protocol::Status& s) {
+  using protocol::ControllerState;
+  switch (s.state) {
+    case ControllerState::FeedHold: return "feed hold: cycle start (RESUME)";
+    case ControllerState::ProgramStop:
+    case ControllerState::OptionalStop: return "program stop: the operator's acknowledgement";
+    case ControllerState::Alarm: return "alarm " + std::string(protocol::to_string(s.alarm)) + ": reset";
+    default: return "";
+  }
+}
+
 // The operator at a terminal (or a log): a live status line and events on stderr,
 // questions on the terminal; --yes answers them.
 class TerminalOperator : public drivers::JobOperator {
@@ -75,6 +88,8 @@ class TerminalOperator : public drivers::JobOperator {
                   p.actions, s.last_executed_line, p.lines, p.done * 100, gcode::format_duration(p.eta_s).c_str(),
                   std::string(protocol::to_string(s.state)).c_str(), s.x_um / 1000.0, s.y_um / 1000.0, s.z_um / 1000.0,
                   unsigned(s.active_tool));
+    const std::string waiting = waiting_for(s);
+    if (!waiting.empty()) std::snprintf(buf + std::strlen(buf), sizeof buf - std::strlen(buf), "  waiting: %s", waiting.c_str());
     if (tty) {
       std::fprintf(stderr, "\r%s", buf);
     } else {

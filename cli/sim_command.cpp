@@ -128,6 +128,9 @@ void add_sim_command(CLI::App& app, Runner& runner) {
       ->group(faults);
   serve_cmd->add_option("--alarm-at-line", r->faults.alarm_at_line, "EMERGENCY_STOP when program line L is about to run")
       ->group(faults);
+  serve_cmd->add_option("--hold-at-line", r->faults.hold_at_line,
+                        "Feed hold at the machine when program line L is about to run (RESUME goes on)")
+      ->group(faults);
   serve_cmd->callback([&runner, r] { runner = [r] { return run_serve(*r); }; });
 }
 

@@ -28,6 +28,7 @@ struct Controller::Impl {
   double virtual_time = 0;        // machine seconds executed
   double virtual_allowed = 0;     // what the clock allows so far (time scale > 0)
   bool alarm_at_line_fired = false;
+  bool hold_at_line_fired = false;
 
   // The program being executed: the chunk in hand and the next line in it.
   std::optional<protocol::Chunk> chunk;
@@ -182,6 +183,11 @@ struct Controller::Impl {
     if (options.alarm_at_line && number == options.alarm_at_line && !alarm_at_line_fired) {
       alarm_at_line_fired = true;
       raise(AlarmCode::EmergencyStop, number, "emergency stop (injected before this line)");
+      return false;
+    }
+    if (options.hold_at_line && number == options.hold_at_line && !hold_at_line_fired) {
+      hold_at_line_fired = true;
+      state = ControllerState::FeedHold;
       return false;
     }
     const LineOutcome o = executor->execute_line(text, int(number));

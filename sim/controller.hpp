@@ -48,6 +48,9 @@ struct ControllerOptions {
   // Fault injection: when line `alarm_at_line` is about to execute, raise EMERGENCY_STOP
   // (0: never).
   std::uint32_t alarm_at_line = 0;
+  // Fault injection: when line `hold_at_line` is about to execute, hold the feed as an
+  // operator at the machine would (0: never); RESUME goes on.
+  std::uint32_t hold_at_line = 0;
   // advance() returns right after executing any of these lines (sorted ascending), so a
   // fault injector can reboot the controller exactly there.
   std::vector<std::uint32_t> break_after_lines;

@@ -24,12 +24,14 @@ struct FaultOptions {
   std::uint32_t exception_every = 0;  ///< every N-th request answered "busy" (Modbus exception 6) unprocessed; 0: never
   std::vector<std::uint32_t> reboot_after_lines;  ///< reboot the controller once it executed L lines (each L once)
   std::uint32_t alarm_at_line = 0;    ///< EMERGENCY_STOP when this program line is about to execute (the controller does it)
+  std::uint32_t hold_at_line = 0;     ///< feed hold at the machine when this line is about to execute (cycle start: RESUME)
   /// Random faults: each event of a kind with period N is hit with probability 1/N, each
   /// reply held back a uniform 0..delay_ms ms, all drawn from this seed. Unset: periodic.
   std::optional<std::uint64_t> seed;
 
   bool any() const {
-    return drop_every || delay_ms || corrupt_every || exception_every || !reboot_after_lines.empty() || alarm_at_line;
+    return drop_every || delay_ms || corrupt_every || exception_every || !reboot_after_lines.empty() || alarm_at_line ||
+           hold_at_line;
   }
 };
 

@@ -99,6 +99,7 @@ json faults_section_json(const RunReport& r) {
             {"exception_every", faults.exception_every},
             {"reboot_after_lines", faults.reboot_after_lines},
             {"alarm_at_line", faults.alarm_at_line},
+            {"hold_at_line", faults.hold_at_line},
             {"seed", faults.seed ? json(*faults.seed) : json(nullptr)}}},
           {"injected",
            {{"dropped", injected.dropped},

@@ -122,6 +122,7 @@ ControllerOptions controller_options(const ServeOptions& o, const FaultOptions& 
                                   : std::uint16_t(protocol::modbus::kMaxChunkPayload);
   options.heartbeat_timeout_s = o.heartbeat_timeout_s;
   options.alarm_at_line = faults.alarm_at_line;
+  options.hold_at_line = faults.hold_at_line;
   // A reboot lands right after its line: advance() stops there.
   options.break_after_lines.assign(faults.reboot_after_lines.begin(), faults.reboot_after_lines.end());
   std::sort(options.break_after_lines.begin(), options.break_after_lines.end());

@@ -273,6 +273,33 @@ TEST_F(Run, CtrlCHoldsTheFeedAndWithoutAnOperatorAborts) {
   EXPECT_LT(log.size(), program.size());
 }
 
+// A hold at the machine (an operator pressed feed hold there) is not the host's to lift: the
+// host waits, and says so every few seconds in its log and on its status line.
+TEST_F(Run, AFeedHoldAtTheMachineIsWaitedOnOutLoud) {
+  int port = 0;
+  auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "2000", "--hold-at-line", "200"}, "modbus-tcp", port,
+                   false);
+  Background host(command({"run", plan().string(), "--machine", kMachine, "--transport",
+                           "modbus-tcp://127.0.0.1:" + std::to_string(port), "--job", (dir_ / "job").string(), "--yes"}),
+                  dir_, "host");
+  auto count = [](const std::string& text, const std::string& what) {
+    std::size_t n = 0;
+    for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+  };
+  const std::string note = "waiting: the controller is in FEED_HOLD, held at the machine after line 199";
+  // Two notes 5 s apart (the documented period), within 30 s also in the sanitizer build.
+  for (int i = 0; i < 600 && count(slurp(dir_ / "host.err"), note) < 2; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const std::string err = slurp(dir_ / "host.err");
+  EXPECT_GE(count(err, note), 2u) << err.substr(0, 3000);
+  EXPECT_NE(err.find("FEED_HOLD"), std::string::npos) << err.substr(0, 3000);
+  EXPECT_NE(err.find("waiting: feed hold: cycle start (RESUME)"), std::string::npos) << err.substr(0, 3000);
+  EXPECT_TRUE(host.alive()) << "the host gave up on a hold that is the machine's to lift";
+  // The controller ran nothing past the hold (its line log may lag behind, never run ahead).
+  EXPECT_LE(count(slurp(dir_ / "lines.ngc.tmp"), "\n"), 199u);
+}
+
 TEST_F(Run, ASetupChangeStopsForTheOperatorAndGoesOnWhenAcknowledged) {
   // The thin-wall slot's best plan mills from below, then from above: the part is turned
   // over by hand in between (manual_refixture), a program stop with the operator's message.
