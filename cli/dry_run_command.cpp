@@ -98,7 +98,8 @@ class Simulator {
 int run_dry_run(const DryRunArgs& a) {
   if (a.transport != "modbus" && a.transport != "can")
     throw InputError("--transport " + a.transport + ": expected modbus or can");
-  const config::Machine machine = config::load_machine(a.machine);
+  const std::string machine_text = config::read_machine_text(a.machine);
+  const config::Machine machine = config::parse_machine(machine_text, a.machine);
   const fs::path out = a.output;
   fs::create_directories(out);
 
@@ -107,7 +108,7 @@ int run_dry_run(const DryRunArgs& a) {
   options.voxel_size = a.voxel;
   options.memory_budget = memory_budget(a.memory_budget);
   const planner::PlanningResult planned = planner::plan_part(geometry::read_stl(a.part), a.part, machine, options);
-  const planner::ReportSources sources{a.part, a.machine, machine.name};
+  const planner::ReportSources sources{a.part, a.machine, machine.name, machine_text};
   std::fputs(planner::plan_summary(planned, sources).c_str(), stdout);
   if (!planned.verdict.manufacturable || planned.plans.empty()) return kNotManufacturable;
   const fs::path plan_dir = out / "plan";
@@ -133,7 +134,6 @@ int run_dry_run(const DryRunArgs& a) {
   fs::remove_all(out / "job");
   RunRequest run;
   run.input = (plan_dir / "plan.json").string();
-  run.machine = a.machine;
   run.transport = uri;
   run.job = (out / "job").string();
   run.yes = true;

@@ -9,7 +9,7 @@
 #include "cli/export_run.hpp"
 #include "cli/progress.hpp"
 #include "common/error.hpp"
-#include "config/machine_loader.hpp"
+#include "planner/plan_machine.hpp"
 #include "gcode/check.hpp"
 #include "gcode/files.hpp"
 #include "toolpaths/plan_export.hpp"
@@ -24,8 +24,9 @@ int export_plan_programs(const ExportRequest& request) {
 }
 
 int export_plan_programs(const planner::PlanFile& file, const ExportRequest& request) {
-  const std::string machine_path = request.machine.empty() ? file.machine_file : request.machine;
-  const config::Machine machine = config::load_machine(machine_path);
+  const planner::PlanMachine chosen = planner::plan_machine(file, {request.machine, request.machine_override});
+  if (!chosen.note.empty()) std::fprintf(stderr, "%s\n", chosen.note.c_str());
+  const config::Machine& machine = chosen.machine;
   if (file.plans.empty()) throw InputError(request.plan + ": the plan file holds no plans (the part was not manufacturable)");
   if (request.rank < 1 || request.rank > int(file.plans.size()))
     throw InputError("--plan " + std::to_string(request.rank) + ": expected 1.." + std::to_string(file.plans.size()) +
@@ -84,7 +85,11 @@ void add_export_command(CLI::App& app, Runner& runner) {
   cmd->add_option("-o,--output", request->output, "Directory for the programs (created if missing)")->required();
   cmd->add_option("--plan", request->rank, "Which plan, by rank (1 = cheapest)")->default_val(1)->check(greater_than(0));
   cmd->add_option("--dialect", request->dialect, "rs274ngc (LinuxCNC) or fanuc (default: the machine file's gcode.dialect)");
-  cmd->add_option("-m,--machine", request->machine, "Machine description (default: the file the plan was made with)");
+  cmd->add_option("-m,--machine", request->machine,
+                  "Machine description (default: the one plan.json embeds); refused when it is another machine than "
+                  "the plan's, unless --machine-override");
+  cmd->add_flag("--machine-override", request->machine_override,
+                "With --machine: use it even when it is not the machine the plan was made with");
   cmd->callback([&runner, request] { runner = [request] { return export_plan_programs(*request); }; });
 }
 

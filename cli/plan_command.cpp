@@ -38,7 +38,8 @@ planner::PrimitiveFile parse_primitive_argument(const std::string& arg) {
 }
 
 int run_plan(const PlanArgs& args) {
-  const config::Machine machine = config::load_machine(args.machine);
+  const std::string machine_text = config::read_machine_text(args.machine);
+  const config::Machine machine = config::parse_machine(machine_text, args.machine);
   planner::PlanningOptions options;
   options.voxel_size = args.voxel;
   options.memory_budget = memory_budget(args.memory_budget);
@@ -58,7 +59,7 @@ int run_plan(const PlanArgs& args) {
   const geometry::TriangleMesh mesh = geometry::read_stl(args.part);
   const planner::PlanningResult result = planner::plan_part(mesh, args.part, machine, options);
   bar.finish();
-  const planner::ReportSources sources{args.part, args.machine, machine.name};
+  const planner::ReportSources sources{args.part, args.machine, machine.name, machine_text};
   std::fputs(planner::plan_summary(result, sources).c_str(), stdout);
   const std::string plan_dir = !args.output.empty() ? args.output : args.export_dir.empty() ? "" : args.export_dir + "/plan";
   if (!plan_dir.empty()) {
@@ -79,7 +80,6 @@ int run_plan(const PlanArgs& args) {
     request.plan = plan_dir;
     request.output = args.export_dir;
     request.dialect = args.dialect;
-    request.machine = args.machine;
     const int code = export_plan_programs(planner::to_plan_file(result, sources, plan_dir), request);
     if (code != kSuccess) return code;
   }

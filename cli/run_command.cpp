@@ -160,7 +160,9 @@ int run_job(const RunRequest& request) {
   {
     const SigintHold hold;
     result = drivers::execute_job(
-        {request.input, request.machine, request.transport, request.rank, request.job, request.resume, request.from_line}, op);
+        {request.input, request.machine, request.transport, request.rank, request.job, request.resume, request.from_line,
+         request.machine_override},
+        op);
   }
   if (op.tty) std::fprintf(stderr, "\n");
   print_report(result);
@@ -174,7 +176,11 @@ void add_run_command(CLI::App& app, Runner& runner) {
              "with a live status line; a job journal lets --resume continue after the host died (exit 5 when the "
              "machine stopped before the end)");
   cmd->add_option("INPUT", request->input, "plan.json (or its directory) or a G-code program");
-  cmd->add_option("-m,--machine", request->machine, "Machine description (YAML); with --resume: the journal's");
+  cmd->add_option("-m,--machine", request->machine,
+                  "Machine description (YAML); with a plan: the one plan.json embeds, and another machine is refused "
+                  "unless --machine-override; with --resume: the journal's");
+  cmd->add_flag("--machine-override", request->machine_override,
+                "With a plan and --machine: use it even when it is not the machine the plan was made with");
   cmd->add_option("-t,--transport", request->transport,
                   "modbus-tcp://HOST:PORT[?unit=N], modbus-rtu:///dev/DEV[?baud=B&parity=P], socketcand://HOST:PORT/CHANNEL, "
                   "socketcan://IFACE; with --resume: the journal's");

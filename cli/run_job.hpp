@@ -9,7 +9,8 @@ namespace hybridctl::cli {
 
 struct RunRequest {
   std::string input;      // plan.json or its directory, or a program
-  std::string machine;
+  std::string machine;    // empty: a plan's embedded machine
+  bool machine_override = false;  // take `machine` even when it is not the plan's
   std::string transport;  // URI
   int rank = 1;
   std::string job;        // job directory

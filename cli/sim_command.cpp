@@ -5,6 +5,7 @@
 #include <string>
 
 #include "cli/commands.hpp"
+#include "cli/memory_budget.hpp"
 #include "cli/ranges.hpp"
 #include "config/transport_uri.hpp"
 #include "protocol/codes.hpp"
@@ -47,6 +48,7 @@ int run_serve(const sim::ServeOptions& options) {
 
 void add_sim_command(CLI::App& app, Runner& runner) {
   auto r = std::make_shared<sim::ServeOptions>();
+  auto memory_budget_text = std::make_shared<std::string>();
   auto* sim = app.add_subcommand("sim", "The machine simulator");
   sim->require_subcommand(1);
   auto* serve_cmd = sim->add_subcommand(
@@ -104,6 +106,7 @@ void add_sim_command(CLI::App& app, Runner& runner) {
                                            "design shrunk by the tolerance is protected");
   auto* stock_vdb = serve_cmd->add_option("--stock-vdb", r->stock_vdb, "Stock from a .vdb file")->check(CLI::ExistingFile);
   stock_plan->excludes(stock_vdb);
+  add_memory_budget_option(serve_cmd, *memory_budget_text);
   serve_cmd->add_option("--plan", r->plan, "With --stock: which plan (rank) to take the stock from")->capture_default_str();
   serve_cmd->add_option("--report", r->report, "Write the run report (JSON) here at the end");
   serve_cmd->add_option("--line-log", r->line_log, "Write every executed program line here, in execution order");
@@ -131,7 +134,12 @@ void add_sim_command(CLI::App& app, Runner& runner) {
   serve_cmd->add_option("--hold-at-line", r->faults.hold_at_line,
                         "Feed hold at the machine when program line L is about to run (RESUME goes on)")
       ->group(faults);
-  serve_cmd->callback([&runner, r] { runner = [r] { return run_serve(*r); }; });
+  serve_cmd->callback([&runner, r, memory_budget_text] {
+    runner = [r, memory_budget_text] {
+      r->memory_budget = memory_budget(*memory_budget_text);
+      return run_serve(*r);
+    };
+  });
 }
 
 }  // namespace hybridctl::cli

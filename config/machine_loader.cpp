@@ -84,7 +84,7 @@ Machine parse_machine(std::string_view yaml_text, std::string file_name) {
   return machine;
 }
 
-Machine load_machine(const std::filesystem::path& path) {
+std::string read_machine_text(const std::filesystem::path& path) {
   const std::string name = path.string();
   const auto fail = [&name](const std::string& why) {
     return MachineFileError({Diagnostic{name, 0, 0, why}});
@@ -120,7 +120,9 @@ Machine load_machine(const std::filesystem::path& path) {
   }
   ::close(fd);
   if (read_error != 0) throw fail("cannot read: " + system_error(read_error));
-  return parse_machine(text, name);
+  return text;
 }
+
+Machine load_machine(const std::filesystem::path& path) { return parse_machine(read_machine_text(path), path.string()); }
 
 }  // namespace hybridctl::config

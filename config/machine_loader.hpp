@@ -17,7 +17,12 @@ namespace hybridctl::config {
 /// Throws MachineFileError (and nothing else) on any problem.
 Machine load_machine(const std::filesystem::path& path);
 
-/// Parses `yaml_text`; `file_name` is used in diagnostics only.
+/// The text of the machine file at `path`, as load_machine reads it (what plan.json embeds).
+/// Throws MachineFileError "path: cannot read: <reason>".
+std::string read_machine_text(const std::filesystem::path& path);
+
+/// Parses `yaml_text`; `file_name` is used in diagnostics only (for a machine embedded in
+/// a plan: "DIR/plan.json (embedded machine)").
 /// Throws MachineFileError (and nothing else) on any problem.
 Machine parse_machine(std::string_view yaml_text, std::string file_name);
 

@@ -14,6 +14,7 @@
 #include "gcode/post.hpp"
 #include "gcode/program.hpp"
 #include "protocol/chunk.hpp"
+#include "planner/plan_machine.hpp"
 #include "toolpaths/plan_export.hpp"
 
 namespace hybridctl::drivers {
@@ -37,6 +38,7 @@ struct Job {
   bool resumed = false;
   bool restarted = false;          // resumed at --from-line as a new program (the controller lost it)
   config::Machine machine;
+  std::string embedded_machine;    // a plan's machine text when no machine file was given: kept in the job directory
   JournalHeader header;
   std::optional<Journal> journal;
   std::string text;                // as read or posted: what `gcode check` reads
@@ -60,14 +62,19 @@ void open_resumed_job(const JobRequest& request, Job& job) {
 
 // A plan is exported and posted now (the program `hybridctl export` writes); a program
 // file is taken as it is.
-void assemble_new_job(const JobRequest& request, Job& job) {
+void assemble_new_job(const JobRequest& request, Job& job, JobOperator& op) {
   if (request.input.empty()) throw InputError("expected a PLAN.json or PROGRAM.ngc to run, or --resume JOB");
-  if (request.machine.empty()) throw InputError("--machine: expected the machine file");
   if (request.transport.empty()) throw InputError("--transport: expected a URI (" + std::string("modbus-tcp://HOST:PORT, ...") + ")");
-  job.machine = config::load_machine(request.machine);
   const fs::path in = request.input;
-  if (fs::is_directory(in) || in.extension() == ".json") {
+  const bool is_plan = fs::is_directory(in) || in.extension() == ".json";
+  if (!is_plan && request.machine.empty()) throw InputError("--machine: expected the machine file");
+  if (is_plan) {
     const planner::PlanFile file = planner::read_plan_file(in);
+    planner::PlanMachine chosen = planner::plan_machine(file, {request.machine, request.machine_override});
+    if (!chosen.note.empty()) op.note(chosen.note);
+    job.machine = std::move(chosen.machine);
+    if (chosen.file.empty()) job.embedded_machine = std::move(chosen.text);
+    job.header.machine = chosen.file.empty() ? "" : fs::absolute(chosen.file).string();
     if (request.rank < 1 || request.rank > int(file.plans.size()))
       throw InputError("--plan " + std::to_string(request.rank) + ": expected 1.." + std::to_string(file.plans.size()));
     const auto& plan = file.plans[std::size_t(request.rank - 1)];
@@ -77,11 +84,12 @@ void assemble_new_job(const JobRequest& request, Job& job) {
     job.text = job.program.text();
     job.header.source = in.string() + " plan " + std::to_string(request.rank);
   } else {
+    job.machine = config::load_machine(request.machine);
     job.text = gcode::read_text_file(in);
     job.program = gcode::PostedProgram::from_lines(protocol::program_lines(job.text));
     job.header.source = in.string();
+    job.header.machine = fs::absolute(request.machine).string();
   }
-  job.header.machine = fs::absolute(request.machine).string();
   job.header.transport = request.transport;
 }
 
@@ -111,6 +119,12 @@ void open_journal(const JobRequest& request, Job& job, std::uint64_t identity) {
   const fs::path program = fs::absolute(dir / "program.ngc");
   const std::string text = protocol::program_text(job.program.lines);
   if (!fs::exists(program) || gcode::read_text_file(program) != text) gcode::write_text_file(program, text);
+  if (!job.embedded_machine.empty()) {
+    // The plan's embedded machine, as a file a resume loads it from.
+    const fs::path machine = fs::absolute(dir / "machine.yaml");
+    gcode::write_text_file(machine, job.embedded_machine);
+    job.header.machine = machine.string();
+  }
   job.header.program = program.string();
   job.header.identity = identity;
   job.header.lines = std::uint32_t(job.program.lines.size());
@@ -253,7 +267,7 @@ JobResult execute_job(const JobRequest& request, JobOperator& op) {
   if (!request.resume.empty())
     open_resumed_job(request, job);
   else
-    assemble_new_job(request, job);
+    assemble_new_job(request, job, op);
   const std::uint64_t identity = protocol::program_identity(job.program.lines);
   const double estimated_s = precheck(request, job, op);
   open_journal(request, job, identity);

@@ -30,12 +30,13 @@ namespace hybridctl::drivers {
 
 struct JobRequest {
   std::string input;      ///< plan.json (or its directory) or a G-code program; empty with `resume`
-  std::string machine;    ///< machine file; with `resume`: empty for the journal's
+  std::string machine;    ///< machine file; with a plan: empty for the one it embeds; with `resume`: empty for the journal's
   std::string transport;  ///< URI; with `resume`: empty for the journal's
   int rank = 1;           ///< with a plan: which plan, by rank
   std::string job;        ///< job directory; empty: jobs/IDENTITY (first 12 hex digits)
   std::string resume;     ///< job directory to resume
   unsigned from_line = 0; ///< with `resume`: restart the program there (the controller lost it)
+  bool machine_override = false;  ///< with a plan: take `machine` even when it is not the plan's
 };
 
 /// The job as it starts streaming.

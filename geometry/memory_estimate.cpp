@@ -58,7 +58,8 @@ std::string format_bytes(double b) {
   return buf;
 }
 
-void check_memory_budget(const std::function<double(double)>& estimate, double h, std::uint64_t budget, const std::string& what) {
+void check_memory_budget(const std::function<double(double)>& estimate, double h, std::uint64_t budget, const std::string& what,
+                         const std::string& advice) {
   const double need = estimate(h);
   if (need <= double(budget)) return;
   // Memory falls as the voxel grows: double until it fits, then bisect to 1 %.
@@ -74,7 +75,7 @@ void check_memory_budget(const std::function<double(double)>& estimate, double h
   char voxel[32];
   std::snprintf(voxel, sizeof voxel, "%.3g", hi * 1.01);
   throw InputError(what + " needs about " + format_bytes(need) + " of memory, over the budget of " +
-                   format_bytes(double(budget)) + " (--memory-budget; default half the physical memory); --voxel " + voxel +
+                   format_bytes(double(budget)) + " (--memory-budget; default half the physical memory); " + advice + voxel +
                    " or larger fits");
 }
 

@@ -28,6 +28,8 @@ std::string format_bytes(double bytes);
 // Refuses (InputError, exit 3) when `estimate(h)` exceeds `budget`: the message names
 // the estimate, the budget and the smallest voxel size at which `estimate` fits.
 // `what` says what the grid is for ("planning the bracket at 0.01 mm").
-void check_memory_budget(const std::function<double(double)>& estimate, double h, std::uint64_t budget, const std::string& what);
+// `advice` comes before the voxel size: "--voxel " where the command takes one.
+void check_memory_budget(const std::function<double(double)>& estimate, double h, std::uint64_t budget, const std::string& what,
+                         const std::string& advice = "--voxel ");
 
 }  // namespace hybridctl::geometry

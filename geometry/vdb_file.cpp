@@ -69,6 +69,28 @@ void write_vdb(const Solid& solid, const std::filesystem::path& path, const std:
   file.commit();
 }
 
+std::optional<VdbExtent> read_vdb_extent(const std::filesystem::path& path) {
+  vdb::initialize();
+  try {
+    openvdb::io::File in(path.string());
+    in.open(false);
+    const openvdb::GridPtrVecPtr grids = in.readAllGridMetadata();
+    in.close();
+    for (const auto& g : *grids) {
+      if (!g->isType<openvdb::FloatGrid>() && !g->isType<openvdb::BoolGrid>()) continue;
+      const auto lo = g->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MIN);
+      const auto hi = g->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MAX);
+      if (!lo || !hi) return std::nullopt;
+      const openvdb::math::Transform& xform = g->transform();
+      const openvdb::Vec3d a = xform.indexToWorld(openvdb::Vec3d(lo->value()));
+      const openvdb::Vec3d b = xform.indexToWorld(openvdb::Vec3d(hi->value()));
+      return VdbExtent{xform.voxelSize()[0], {{a.x(), a.y(), a.z()}, {b.x(), b.y(), b.z()}}};
+    }
+  } catch (const openvdb::Exception&) {
+  }
+  return std::nullopt;
+}
+
 Solid read_vdb(const std::filesystem::path& path) {
   vdb::initialize();
   const std::string name = path.string();

@@ -3,6 +3,7 @@
 // OpenVDB's own vdb_print / vdb_view).
 
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "geometry/solid.hpp"
@@ -18,5 +19,15 @@ void write_vdb(const Solid& solid, const std::filesystem::path& path, const std:
 // size and origin come from the grid's transform, which must be linear and uniform.
 // Throws hybridctl::InputError naming the file and what was expected.
 Solid read_vdb(const std::filesystem::path& path);
+
+// What read_vdb would allocate for, from the file's grid metadata alone (no voxels read):
+// the first float or bool grid's voxel size and the mm box its active voxels span, as
+// OpenVDB records it on writing. Nullopt when the file does not say or cannot be read
+// (read_vdb then says why).
+struct VdbExtent {
+  double voxel_size = 0;
+  Box3 box;
+};
+std::optional<VdbExtent> read_vdb_extent(const std::filesystem::path& path);
 
 }  // namespace hybridctl::geometry

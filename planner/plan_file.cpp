@@ -7,6 +7,7 @@
 
 #include "common/error.hpp"
 #include "geometry/vdb_file.hpp"
+#include "planner/plan_machine.hpp"
 #include "planner/plan_report.hpp"
 
 namespace hybridctl::planner {
@@ -104,20 +105,28 @@ geometry::Solid as_read_back(const geometry::Solid& s, const geometry::Lattice& 
   return on_plan_grid(intersect(s, geometry::Solid::filled(s.lattice(), s.bounding_box())), lattice, domain);
 }
 
-}  // namespace
-
-PlanFile read_plan_file(const fs::path& given) {
-  const fs::path json_path = fs::is_directory(given) ? given / "plan.json" : given;
-  const std::string name = json_path.string();
-  std::ifstream in(json_path, std::ios::binary);
-  if (!in) throw InputError(name + ": cannot read: no such file (expected a plan.json written by `hybridctl plan`)");
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  return parse_plan_file(buffer.str(), json_path);
+// The machine: embedded (`yaml` and its `hash`) since plans carry it; older plans name
+// only its `file`.
+void read_machine(const Node& machine, PlanFile& f) {
+  f.machine_file = machine.at("file").str();
+  if (!machine.has("yaml")) return;
+  f.machine_yaml = machine.at("yaml").str();
+  f.machine_hash = machine.at("hash").str();
+  if (f.machine_hash != machine_text_hash(f.machine_yaml))
+    machine.at("hash").fail("\"" + machine_text_hash(f.machine_yaml) + "\", the FNV-1a 64 hash of /machine/yaml");
 }
 
-PlanFile parse_plan_file(std::string_view json_text, const fs::path& json_path) {
-  const std::string name = json_path.string();
+fs::path plan_json_path(const fs::path& given) { return fs::is_directory(given) ? given / "plan.json" : given; }
+
+std::string read_plan_text(const fs::path& json_path) {
+  std::ifstream in(json_path, std::ios::binary);
+  if (!in) throw InputError(json_path.string() + ": cannot read: no such file (expected a plan.json written by `hybridctl plan`)");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  return buffer.str();
+}
+
+json parse_plan_json(std::string_view json_text, const std::string& name) {
   json root;
   try {
     root = json::parse(json_text);
@@ -129,19 +138,45 @@ PlanFile parse_plan_file(std::string_view json_text, const fs::path& json_path) 
   const Node top(root, name, "");
   if (top.at("format").str() != "hybridctl-plan") top.at("format").fail("\"hybridctl-plan\"");
   if (top.at("version").integer() != 1) top.at("version").fail("version 1 (this hybridctl reads version 1)");
+  return root;
+}
 
+void read_grid(const Node& grid, geometry::Lattice& lattice, geometry::IndexBox& domain) {
+  lattice.voxel_size = grid.at("voxel_size").number();
+  if (lattice.voxel_size <= 0) grid.at("voxel_size").fail("a positive voxel size");
+  lattice.origin = grid.at("origin").vec3();
+  domain = {grid.at("domain").at("lo").index3(), grid.at("domain").at("hi").index3()};
+  if (domain.empty()) grid.at("domain").fail("a non-empty box");
+  if (double(domain.voxel_count()) > 4e9) grid.at("domain").fail("a domain of at most 4e9 voxels");
+}
+
+}  // namespace
+
+PlanFile read_plan_file(const fs::path& given) {
+  const fs::path json_path = plan_json_path(given);
+  return parse_plan_file(read_plan_text(json_path), json_path);
+}
+
+PlanGrid read_plan_grid(const fs::path& given) {
+  const fs::path json_path = plan_json_path(given);
+  const json root = parse_plan_json(read_plan_text(json_path), json_path.string());
+  const Node top(root, json_path.string(), "");
+  PlanGrid g;
+  read_grid(top.at("grid"), g.lattice, g.domain);
+  g.primitives = top.at("primitives").size();
+  return g;
+}
+
+PlanFile parse_plan_file(std::string_view json_text, const fs::path& json_path) {
+  const std::string name = json_path.string();
+  const json root = parse_plan_json(json_text, name);
+  const Node top(root, name, "");
   PlanFile f;
   f.directory = json_path.parent_path().empty() ? fs::path(".") : json_path.parent_path();
   f.part = top.at("part").str();
   f.machine_name = top.at("machine").at("name").str();
-  f.machine_file = top.at("machine").at("file").str();
-  const Node grid = top.at("grid");
-  f.lattice.voxel_size = grid.at("voxel_size").number();
-  if (f.lattice.voxel_size <= 0) grid.at("voxel_size").fail("a positive voxel size");
-  f.lattice.origin = grid.at("origin").vec3();
-  f.domain = {grid.at("domain").at("lo").index3(), grid.at("domain").at("hi").index3()};
-  if (f.domain.empty()) grid.at("domain").fail("a non-empty box");
-  if (double(f.domain.voxel_count()) > 4e9) grid.at("domain").fail("a domain of at most 4e9 voxels");
+  read_machine(top.at("machine"), f);
+  read_grid(top.at("grid"), f.lattice, f.domain);
   f.tolerance = top.at("tolerance").number();
   f.design = load_region(f.directory, top.at("design").at("file"), f.lattice, f.domain);
 
@@ -188,15 +223,17 @@ PlanFile parse_plan_file(std::string_view json_text, const fs::path& json_path) 
 PlanFile to_plan_file(const PlanningResult& r, const ReportSources& sources, const fs::path& directory) {
   PlanFile f;
   f.directory = directory;
-  f.part = sources.part_path;
+  f.part = path_from_plan_directory(sources.part_path, directory);
   f.machine_name = sources.machine_name;
-  f.machine_file = sources.machine_path;
+  f.machine_file = path_from_plan_directory(sources.machine_path, directory);
+  f.machine_yaml = sources.machine_text;
+  f.machine_hash = machine_text_hash(sources.machine_text);
   f.lattice = r.lattice;
   f.domain = r.domain;
   f.tolerance = r.tolerance;
   f.design = as_read_back(r.design, f.lattice, f.domain);
   for (const Primitive& p : r.primitives) {
-    f.primitives.push_back({p.name, p.label, std::string(to_string(p.kind)), p.mode, p.capability, p.setup,
+    f.primitives.push_back({p.name, p.label, std::string(to_string(p.kind)), p.mode, primitive_capability(p, directory), p.setup,
                             p.tool_number, as_read_back(p.region, f.lattice, f.domain)});
   }
   for (std::size_t k = 0; k < r.plans.size(); ++k) {

@@ -44,8 +44,11 @@ struct PlanFilePlan {
 
 struct PlanFile {
   std::filesystem::path directory;
-  std::string part;
-  std::string machine_name, machine_file;  // machine_file as given when planning
+  std::string part;                        // relative to `directory` (older plans: as given)
+  std::string machine_name, machine_file;  // machine_file relative to `directory` (older plans: as given)
+  std::string machine_yaml;                // the machine file's text, embedded; empty in older plans
+  std::string machine_hash;                // FNV-1a 64 of machine_yaml, 16 hex digits
+
   geometry::Lattice lattice;
   geometry::IndexBox domain;
   double tolerance = 0;
@@ -67,6 +70,15 @@ PlanFile read_plan_file(const std::filesystem::path& plan_json_or_directory);
 // The same from the text of a plan.json that stands at `json_path` (used in messages; the
 // .vdb files are read from its directory, the file itself is not read).
 PlanFile parse_plan_file(std::string_view json_text, const std::filesystem::path& json_path);
+
+// The grid of a plan.json (or its directory) and how many primitives it has, without
+// reading any .vdb: enough to size the memory its solids take before loading them.
+struct PlanGrid {
+  geometry::Lattice lattice;
+  geometry::IndexBox domain;
+  std::size_t primitives = 0;
+};
+PlanGrid read_plan_grid(const std::filesystem::path& plan_json_or_directory);
 
 // The planning result as write_plan_directory(result, sources, directory) writes it and
 // read_plan_file(directory) reads it back, without the files: equal to what is read back,

@@ -10,6 +10,7 @@
 #include "common/number_text.hpp"
 #include "common/error.hpp"
 #include "geometry/vdb_file.hpp"
+#include "planner/plan_machine.hpp"
 
 namespace hybridctl::planner {
 namespace {
@@ -42,12 +43,27 @@ std::string fixed(double v, int digits) { return fixed_number(v, digits); }
 
 }  // namespace
 
-std::string plan_json(const PlanningResult& r, const ReportSources& src) {
+std::string path_from_plan_directory(const std::string& path, const std::filesystem::path& directory) {
+  namespace fs = std::filesystem;
+  if (path.empty()) return path;
+  const fs::path absolute = fs::absolute(path).lexically_normal();
+  const fs::path relative = absolute.lexically_relative(fs::absolute(directory).lexically_normal());
+  return relative.empty() ? absolute.generic_string() : relative.generic_string();
+}
+
+std::string primitive_capability(const Primitive& p, const std::filesystem::path& directory) {
+  return p.kind == PrimitiveKind::File ? path_from_plan_directory(p.capability, directory) : p.capability;
+}
+
+std::string plan_json(const PlanningResult& r, const ReportSources& src, const std::filesystem::path& directory) {
   json doc;
   doc["format"] = "hybridctl-plan";
   doc["version"] = kPlanFormatVersion;
-  doc["part"] = src.part_path;
-  doc["machine"] = {{"name", src.machine_name}, {"file", src.machine_path}};
+  doc["part"] = path_from_plan_directory(src.part_path, directory);
+  doc["machine"] = {{"name", src.machine_name},
+                    {"file", path_from_plan_directory(src.machine_path, directory)},
+                    {"hash", machine_text_hash(src.machine_text)},
+                    {"yaml", src.machine_text}};
   doc["grid"] = {{"voxel_size", r.lattice.voxel_size},
                  {"origin", vec(r.lattice.origin)},
                  {"domain", {{"lo", ivec(r.domain.lo)}, {"hi", ivec(r.domain.hi)}}}};
@@ -65,7 +81,7 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src) {
   json prims = json::array();
   for (const Primitive& p : r.primitives) {
     json j = {{"name", p.name},       {"label", p.label},       {"kind", to_string(p.kind)},
-              {"mode", mode_name(p.mode)}, {"capability", p.capability}, {"setup", p.setup},
+              {"mode", mode_name(p.mode)}, {"capability", primitive_capability(p, directory)}, {"setup", p.setup},
               {"cost_per_mm3", p.cost_per_mm3}, {"volume", p.region.volume()},
               {"file", "primitives/" + p.name + ".vdb"}};
     if (p.tool_number) j["tool_number"] = p.tool_number;
@@ -173,7 +189,7 @@ void write_plan_directory(const PlanningResult& r, const ReportSources& src, con
       geometry::write_vdb(plan_outcome(r, r.plans[k]), staging / "plans" / ("plan-" + std::to_string(k + 1) + ".vdb"),
                           "plan-" + std::to_string(k + 1));
     std::ofstream out(staging / "plan.json");
-    out << plan_json(r, src);
+    out << plan_json(r, src, dir);
     if (!out.flush()) throw InputError((staging / "plan.json").string() + ": cannot write");
     out.close();
     const fs::path old = parent / ("." + dir.filename().string() + ".old-" + std::to_string(::getpid()));

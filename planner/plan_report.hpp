@@ -13,13 +13,22 @@ namespace hybridctl::planner {
 inline constexpr int kPlanFormatVersion = 1;
 
 struct ReportSources {
-  std::string part_path;
-  std::string machine_path;
+  std::string part_path;     // as given (the summary prints it so)
+  std::string machine_path;  // as given
   std::string machine_name;
+  std::string machine_text;  // the machine file's YAML, which plan.json embeds
 };
 
-// The JSON document, as text.
-std::string plan_json(const PlanningResult& result, const ReportSources& sources);
+// The JSON document, as text, for a plan.json in `directory`: the paths it names are
+// relative to that directory.
+std::string plan_json(const PlanningResult& result, const ReportSources& sources, const std::filesystem::path& directory);
+
+// `path` (absolute, or relative to the working directory) as plan.json in `directory`
+// records it: relative to that directory, or absolute when no relative path leads there.
+std::string path_from_plan_directory(const std::string& path, const std::filesystem::path& directory);
+// A primitive's `capability` as plan.json records it: a file primitive's path relative to
+// the plan's directory, any other as it is.
+std::string primitive_capability(const Primitive& primitive, const std::filesystem::path& directory);
 
 // Writes DIR/plan.json, DIR/design.vdb, DIR/primitives/Pn.vdb, DIR/plans/plan-k.vdb.
 // DIR must not exist, be empty, or hold an earlier plan (it is replaced); anything else

@@ -11,6 +11,7 @@
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
 #include "config/transport_uri.hpp"
+#include "geometry/memory_estimate.hpp"
 #include "geometry/mesh.hpp"
 #include "geometry/morphology.hpp"
 #include "geometry/surface_mesh.hpp"
@@ -109,6 +110,30 @@ std::string stock_from_plan(const ServeOptions& o, ControllerOptions& options) {
   }
   options.protected_region = geometry::erode(file.design, geometry::Ball{file.tolerance});
   return described;
+}
+
+// The stock's grids must fit the memory budget, checked from plan.json's grid or the
+// .vdb's metadata before any voxel is loaded (geometry/memory_estimate.hpp).
+void check_stock_memory(const ServeOptions& o) {
+  const std::uint64_t budget = o.memory_budget ? o.memory_budget : geometry::default_memory_budget();
+  if (!o.stock_plan.empty()) {
+    const planner::PlanGrid grid = planner::read_plan_grid(o.stock_plan);
+    const geometry::Box3 region = grid.lattice.extent(grid.domain);
+    // The plan as read (design and every primitive), the stock, the spared region and the
+    // controller's material: dense solids over the plan's domain.
+    const double solids = double(grid.primitives) + 4;
+    geometry::check_memory_budget([&](double h) { return solids * geometry::solid_bytes(region, h); },
+                                  grid.lattice.voxel_size, budget, "the stock of " + o.stock_plan,
+                                  "a plan made with --voxel ");
+  }
+  if (!o.stock_vdb.empty()) {
+    const std::optional<geometry::VdbExtent> extent = geometry::read_vdb_extent(o.stock_vdb);
+    if (!extent) return;  // read_vdb says what is wrong with the file
+    // The float grid as read (4 bytes a voxel at most), the stock and the controller's material.
+    const auto bytes = [&](double h) { return 4 * geometry::grid_voxels(extent->box, h) + 2 * geometry::solid_bytes(extent->box, h); };
+    geometry::check_memory_budget(bytes, extent->voxel_size, budget, "the stock " + o.stock_vdb,
+                                  "a stock .vdb with a voxel size of ");
+  }
 }
 
 ControllerOptions controller_options(const ServeOptions& o, const FaultOptions& faults) {
@@ -245,6 +270,7 @@ void write_as_built(const Controller& controller, const std::string& path) {
 ServeOutcome serve(const ServeOptions& o, const std::function<void(const std::string&)>& say) {
   const CheckedOptions checked = check_options(o);
   const config::Machine machine = config::load_machine(o.machine);
+  check_stock_memory(o);
   ControllerOptions options = controller_options(o, checked.faults);
   std::string stock = "none";
   if (!o.stock_plan.empty()) stock = stock_from_plan(o, options);

@@ -36,6 +36,7 @@ struct ServeOptions {
   double heartbeat_timeout_s = 2.0;
   std::string stock_plan;  // plan.json or its directory
   std::string stock_vdb;
+  std::uint64_t memory_budget = 0;  // bytes the stock's grids may take; 0: geometry::default_memory_budget()
   int plan = 1;            // with stock_plan: which plan's stock
   std::string report;      // run report (JSON) path
   std::string as_built;    // .vdb or .stl path

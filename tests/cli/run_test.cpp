@@ -150,6 +150,23 @@ TEST_F(Run, TheBestPlanOverModbusTcp) {
   EXPECT_NE(slurp(dir_ / "run.out").find("completed after"), std::string::npos);
 }
 
+// A plan directory copied elsewhere runs from a third directory with the machine it embeds,
+// which the job directory keeps for a resume.
+TEST_F(Run, ACopiedPlanRunsFromAnotherDirectoryWithItsEmbeddedMachine) {
+  fs::create_directories(dir_ / "copy");
+  fs::create_directories(dir_ / "cwd");
+  fs::copy(plan().parent_path(), dir_ / "copy" / "plan", fs::copy_options::recursive);
+  int port = 0;
+  auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "0"}, "modbus-tcp", port);
+  const std::string cmd = "cd " + quote((dir_ / "cwd").string()) + " && " +
+                          command({"run", "../copy/plan/plan.json", "--transport", "modbus-tcp://127.0.0.1:" + std::to_string(port),
+                                   "--job", (dir_ / "job").string(), "--yes"}) +
+                          " >" + quote((dir_ / "run.out").string()) + " 2>" + quote((dir_ / "run.err").string()) + " </dev/null";
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << slurp(dir_ / "run.err");
+  expect_exactly_once(*sim);
+  EXPECT_EQ(slurp(dir_ / "job" / "machine.yaml"), slurp(kMachine));
+}
+
 TEST_F(Run, TheBestPlanOverSocketcand) {
   int port = 0;
   auto sim = serve({"--socketcand", "127.0.0.1:0", "--time-scale", "0"}, "socketcand", port);

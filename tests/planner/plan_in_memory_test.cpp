@@ -11,6 +11,7 @@
 #include "config/machine_loader.hpp"
 #include "geometry/mesh.hpp"
 #include "planner/plan_file.hpp"
+#include "planner/plan_machine.hpp"
 #include "planner/plan_report.hpp"
 
 namespace hybridctl::planner {
@@ -26,14 +27,15 @@ void expect_same_storage(const geometry::Solid& memory, const geometry::Solid& d
 }
 
 TEST(PlanInMemory, EqualsThePlanReadBackFromItsDirectory) {
-  const config::Machine machine = config::load_machine(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
+  const std::string machine_text = config::read_machine_text(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
+  const config::Machine machine = config::parse_machine(machine_text, "hybrid-3axis.yaml");
   const geometry::TriangleMesh part = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/bracket.stl");
   PlanningOptions options;
   options.voxel_size = 1.0;
   options.top_k = 3;
   const PlanningResult result = plan_part(part, "bracket.stl", machine, options);
   ASSERT_FALSE(result.plans.empty());
-  const ReportSources sources{"bracket.stl", "hybrid-3axis.yaml", machine.name};
+  const ReportSources sources{"bracket.stl", "hybrid-3axis.yaml", machine.name, machine_text};
   const fs::path dir = fs::temp_directory_path() / ("hybridctl-plan-in-memory-" + std::to_string(::getpid()));
   write_plan_directory(result, sources, dir);
   const PlanFile disk = read_plan_file(dir);
@@ -42,6 +44,9 @@ TEST(PlanInMemory, EqualsThePlanReadBackFromItsDirectory) {
   const PlanFile memory = to_plan_file(result, sources, dir);
   EXPECT_TRUE(memory == disk);
   EXPECT_EQ(memory.directory, disk.directory);
+  EXPECT_EQ(memory.machine_yaml, machine_text);
+  EXPECT_EQ(disk.machine_hash, machine_text_hash(machine_text));
+  EXPECT_EQ(memory.part, disk.part);
   EXPECT_EQ(memory.lattice, disk.lattice);
   EXPECT_EQ(memory.domain, disk.domain);
   EXPECT_EQ(memory.tolerance, disk.tolerance);

@@ -39,7 +39,7 @@ const Planned& planned() {
     options.voxel_size = 0.5;
     const planner::PlanningResult r = planner::plan_part(mesh, "bracket.stl", out.machine, options);
     const fs::path dir = fs::temp_directory_path() / ("hybridctl-replay-" + std::to_string(::getpid()));
-    planner::write_plan_directory(r, {"bracket.stl", "hybrid-3axis.yaml", out.machine.name}, dir);
+    planner::write_plan_directory(r, {"bracket.stl", "hybrid-3axis.yaml", out.machine.name, ""}, dir);
     out.file = planner::read_plan_file(dir);
     fs::remove_all(dir);
     return out;
