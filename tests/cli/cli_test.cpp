@@ -26,27 +26,16 @@ using hybridctl::cli_testing::Outcome;
 using hybridctl::cli_testing::quote;
 using hybridctl::cli_testing::slurp;
 
-class Cli : public ::testing::Test {
+class Cli : public hybridctl::cli_testing::DirectoryTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("hybridctl-cli-" + std::to_string(::getpid()) + "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  Outcome run(const std::vector<std::string>& args) {
-    std::string cmd = quote(HYBRIDCTL_EXE);
-    for (const auto& a : args) cmd += " " + quote(a);
-    return hybridctl::cli_testing::run_shell(cmd, dir_);
-  }
+  Cli() : DirectoryTest("cli") {}
+  Outcome run(const std::vector<std::string>& args) { return run_hybridctl(args); }
 
   fs::path write(const std::string& name, const std::string& bytes) {
     std::ofstream(dir_ / name, std::ios::binary) << bytes;
     return dir_ / name;
   }
 
-  fs::path dir_;
 };
 
 const std::string kBracket = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/bracket.stl";

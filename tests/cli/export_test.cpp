@@ -18,28 +18,15 @@ namespace fs = std::filesystem;
 
 const fs::path kSource = HYBRIDCTL_SOURCE_DIR;
 
-using hybridctl::cli_testing::Outcome;
-using hybridctl::cli_testing::quote;
-using hybridctl::cli_testing::slurp;
+// Outcome, quote, slurp, run_shell, DirectoryTest.
+using namespace hybridctl::cli_testing;
 
-class Export : public ::testing::Test {
+class Export : public DirectoryTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("hybridctl-export-" + std::to_string(::getpid()) + "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  Export() : DirectoryTest("export") {}
+  Outcome sh(const std::string& command) { return run_shell(command, dir_); }
+  Outcome hybridctl(const std::vector<std::string>& args) { return run_hybridctl(args); }
 
-  Outcome sh(const std::string& command) { return hybridctl::cli_testing::run_shell(command, dir_); }
-  Outcome hybridctl(const std::vector<std::string>& args) {
-    std::string cmd = quote(HYBRIDCTL_EXE);
-    for (const auto& a : args) cmd += " " + quote(a);
-    return sh(cmd);
-  }
-
-  fs::path dir_;
 };
 
 TEST_F(Export, EveryProgramForTheExamplePartsPassesRs274AndOurCheck) {

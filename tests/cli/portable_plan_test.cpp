@@ -19,19 +19,16 @@ namespace fs = std::filesystem;
 const fs::path kSource = HYBRIDCTL_SOURCE_DIR;
 const std::string kMachine = (kSource / "examples/machines/hybrid-3axis.yaml").string();
 
-using hybridctl::cli_testing::Outcome;
-using hybridctl::cli_testing::quote;
-using hybridctl::cli_testing::slurp;
+// Outcome, quote, slurp, run_shell, DirectoryTest.
+using namespace hybridctl::cli_testing;
 
-class PortablePlan : public ::testing::Test {
+class PortablePlan : public DirectoryTest {
  protected:
+  PortablePlan() : DirectoryTest("portable") {}
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("hybridctl-portable-" + std::to_string(::getpid()) + "-" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
+    DirectoryTest::SetUp();
     fs::create_directories(dir_ / "elsewhere");
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   // hybridctl ARGS run from `cwd`.
   Outcome hybridctl(const std::vector<std::string>& args, const fs::path& cwd) {
@@ -59,7 +56,6 @@ class PortablePlan : public ::testing::Test {
     return all;
   }
 
-  fs::path dir_;
 };
 
 TEST_F(PortablePlan, ACopiedPlanExportsTheSameProgramsFromAnotherDirectory) {

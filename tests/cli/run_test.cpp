@@ -63,8 +63,7 @@ struct Background {
 class Run : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("hybridctl-run-" + std::to_string(::getpid()) + "-" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    dir_ = hybridctl::cli_testing::test_directory("run");
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }

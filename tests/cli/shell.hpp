@@ -10,6 +10,9 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
+
+#include <unistd.h>
 
 #include "../sanitizer_report.hpp"
 
@@ -25,6 +28,12 @@ inline std::string slurp(const std::filesystem::path& p) {
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();
+}
+
+// The directory of the running test, TMP/hybridctl-PREFIX-PID-TEST (not yet created).
+inline std::filesystem::path test_directory(const std::string& prefix) {
+  return std::filesystem::temp_directory_path() / ("hybridctl-" + prefix + "-" + std::to_string(::getpid()) + "-" +
+                                                   ::testing::UnitTest::GetInstance()->current_test_info()->name());
 }
 
 // One argument for /bin/sh, single-quoted.
@@ -49,5 +58,29 @@ inline Outcome run_shell(const std::string& command, const std::filesystem::path
   if (!report.empty()) ADD_FAILURE() << "sanitizer report from " << command << ":\n" << report;
   return r;
 }
+
+// A test with a fresh directory of its own (`dir_`), removed at its end, where the
+// hybridctl it runs leaves its output.
+class DirectoryTest : public ::testing::Test {
+ protected:
+  explicit DirectoryTest(std::string prefix) : prefix_(std::move(prefix)) {}
+  void SetUp() override {
+    dir_ = test_directory(prefix_);
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  // hybridctl ARGS (HYBRIDCTL_EXE), run in the shell.
+  Outcome run_hybridctl(const std::vector<std::string>& args) {
+    std::string cmd = quote(HYBRIDCTL_EXE);
+    for (const auto& a : args) cmd += " " + quote(a);
+    return run_shell(cmd, dir_);
+  }
+
+  std::filesystem::path dir_;
+
+ private:
+  std::string prefix_;
+};
 
 }  // namespace hybridctl::cli_testing
