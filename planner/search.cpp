@@ -213,11 +213,18 @@ std::vector<Plan> find_plans(const PlanningProblem& p, const SearchOptions& opti
     const int id = e.node;
     if (id != 0) {
       int& count = pops[key_of(nodes[std::size_t(id)])];
-      if (count >= options.top_k) continue;  // k cheapest arrivals at this key suffice
+      // k cheapest arrivals at this key suffice, plus one for each plan turned down.
+      if (count >= options.top_k + st.rejected) continue;
       ++count;
     }
     if (id != 0 && is_goal(p, nodes[std::size_t(id)].state)) {
-      plans.push_back(plan_from(nodes, id));
+      Plan plan = plan_from(nodes, id);
+      if (!options.accept || options.accept(plan)) {
+        plans.push_back(std::move(plan));
+      } else if (++st.rejected >= options.max_rejected) {
+        st.limit_reached = true;
+        break;
+      }
       continue;
     }
     if (st.expanded >= options.max_expansions || std::int64_t(nodes.size()) >= options.max_states) {

@@ -6,6 +6,7 @@
 // with the complement (C2), the first action additive (C3), raw stock only first (C4).
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -65,6 +66,7 @@ struct SearchStats {
   bool exhausted = false;  // the search space ran out before k plans were found
   bool limit_reached = false;
   double weight = 1.0;  // of the search that produced the plans (1: proven optimal)
+  std::int64_t rejected = 0;  // goal plans `SearchOptions::accept` turned down
 };
 
 struct SearchOptions {
@@ -77,6 +79,12 @@ struct SearchOptions {
   // weight w > 1 (weighted A*) finds plans faster whose cost is at most w times the
   // optimum; the planner falls back to it when the exact search hits its limits.
   double weight = 1.0;
+  // When set, every plan that reaches the goal is offered to it, cheapest first; only
+  // plans it accepts are returned and count towards top_k, and the search goes on past
+  // the rest (the validation of plans by execution keeps its reasons itself). At most
+  // `max_rejected` plans are turned down before the search stops with limit_reached.
+  std::function<bool(const Plan&)> accept;
+  std::int64_t max_rejected = 50;
 };
 
 // The k cheapest distinct plans, cheapest first, by A* with an admissible and

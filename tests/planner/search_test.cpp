@@ -72,6 +72,43 @@ TEST(PaperExample, FindsE1E2TheirP1P2SwapsAndE3ButNeverE4) {
   for (std::size_t i = 1; i < plans.size(); ++i) EXPECT_LE(plans[i - 1].cost, plans[i].cost);
 }
 
+TEST(PaperExample, PlansTheAcceptHookTurnsDownAreSkippedAndTheNextCheapestTakeTheirPlace) {
+  const VoxelProblem vp = paper_example(false);
+  const auto all = find_plans(vp.problem, {6});
+  ASSERT_EQ(all.size(), 6u);
+  // Turn down every plan whose first step is P1: the search must go on past them and
+  // return the cheapest plans that do not start with P1, in cost order.
+  SearchOptions options{3};
+  std::vector<std::string> offered;
+  options.accept = [&](const Plan& p) {
+    offered.push_back(expression(vp.problem, p));
+    return p.steps.front().primitive != 0;
+  };
+  SearchStats stats;
+  const auto kept = find_plans(vp.problem, options, &stats);
+  std::vector<Plan> expected;
+  for (const Plan& p : enumerate_plans(vp.problem))
+    if (p.steps.front().primitive != 0 && expected.size() < 3) expected.push_back(p);
+  ASSERT_EQ(kept.size(), expected.size());
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    EXPECT_NE(kept[i].steps.front().primitive, 0);
+    EXPECT_NEAR(kept[i].cost, expected[i].cost, 1e-12);
+  }
+  EXPECT_EQ(stats.rejected, std::int64_t(offered.size() - kept.size()));
+  EXPECT_GT(stats.rejected, 0);
+}
+
+TEST(PaperExample, TheSearchStopsAfterMaxRejectedPlansTurnedDown) {
+  const VoxelProblem vp = paper_example(false);
+  SearchOptions options{5};
+  options.accept = [](const Plan&) { return false; };
+  options.max_rejected = 4;
+  SearchStats stats;
+  EXPECT_TRUE(find_plans(vp.problem, options, &stats).empty());
+  EXPECT_EQ(stats.rejected, 4);
+  EXPECT_TRUE(stats.limit_reached);
+}
+
 TEST(PaperExample, WithP1AsRawStockOnlyPlansStartingFromItRemain) {
   const VoxelProblem vp = paper_example(true);
   const auto plans = find_plans(vp.problem, {5});
