@@ -154,8 +154,7 @@ int run_dry_run(const DryRunArgs& a) {
   const planner::Deviation d = planner::measure_deviation(built_here, file.design, file.domain, file.tolerance);
   std::printf("as built    %.1f mm³ (planned %.1f mm³): %.1f mm³ beyond the plan, %.1f mm³ of it missing\n",
               built_here.volume(), planned_shape.volume(), extra.volume(), missing.volume());
-  std::printf("vs design   %.1f mm³ over (worst %.2f mm), %.1f mm³ under (worst %.2f mm); tolerance %.2f mm\n",
-              d.over_volume, d.worst_over, d.under_volume, d.worst_under, file.tolerance);
+  std::printf("vs design   %s\n", planner::deviation_text(d, file.tolerance).c_str());
   std::printf("wrote       %s: plan/, job/, as-built.vdb, sim-report.json, executed-lines.ngc\n", out.c_str());
   return kSuccess;
 }

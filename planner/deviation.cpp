@@ -1,24 +1,76 @@
 #include "planner/deviation.hpp"
 
 #include <algorithm>
+#include <cmath>
 
-#include "geometry/morphology.hpp"
+#include "common/number_text.hpp"
+#include "geometry/distance_field.hpp"
 
 namespace hybridctl::planner {
+namespace {
 
-Deviation measure_deviation(const geometry::Solid& made, const geometry::Solid& design,
-                            const geometry::IndexBox& domain, double tolerance) {
-  const geometry::Solid over = subtract(made, design), under = subtract(design, made);
+using geometry::FarthestVoxel;
+using geometry::IndexBox;
+using geometry::Solid;
+
+// The air around a solid, near enough to hold the nearest air voxel of each of its
+// voxels: the solid's box grown by one (a voxel outside it is never nearer).
+Solid air_around(const Solid& s, const IndexBox& also) {
+  const IndexBox b = box_union(s.bounding_box(), also);
+  return complement(s, {{b.lo.x - 1, b.lo.y - 1, b.lo.z - 1}, {b.hi.x + 1, b.hi.y + 1, b.hi.z + 1}});
+}
+
+// The farther of two, with where it is.
+void take_worst(const FarthestVoxel& f, const geometry::Lattice& lattice, double& worst,
+                std::optional<geometry::Vec3>& at) {
+  if (!f.voxel || (at && f.distance <= worst)) return;
+  worst = f.distance;
+  at = lattice.center(*f.voxel);
+}
+
+}  // namespace
+
+Deviation measure_deviation(const Solid& made, const Solid& design, const IndexBox& /*domain*/, double tolerance) {
+  const Solid over = subtract(made, design), under = subtract(design, made);
+  const geometry::Lattice& lattice = design.lattice();
   const double half = design.voxel_size() / 2;
   Deviation d;
   d.over_volume = over.volume();
   d.under_volume = under.volume();
-  d.worst_over = std::max(0.0, geometry::farthest_distance(over, design) - (over.empty() ? 0 : half));
-  d.worst_under =
-      std::max(0.0, geometry::farthest_distance(under, complement(design, domain)) - (under.empty() ? 0 : half));
+  // From D's other side: material outside D from D, holes in D from D's air.
+  const FarthestVoxel over_from_design = geometry::farthest_voxel(over, design);
+  const FarthestVoxel under_from_air = geometry::farthest_voxel(under, air_around(design, under.bounding_box()));
+  d.worst_over = over.empty() ? 0 : std::max(0.0, over_from_design.distance - half);
+  d.worst_under = under.empty() ? 0 : std::max(0.0, under_from_air.distance - half);
   d.worst_distance = std::max(d.worst_over, d.worst_under);
-  d.within_tolerance = d.worst_distance <= tolerance + 1e-9;
+  take_worst(over_from_design, lattice, d.worst_out, d.worst_out_at);
+  take_worst(under_from_air, lattice, d.worst_out, d.worst_out_at);
+  // From M's other side: missing design from the material made, filled air from M's air.
+  take_worst(geometry::farthest_voxel(under, made), lattice, d.worst_missing, d.worst_missing_at);
+  take_worst(geometry::farthest_voxel(over, air_around(made, over.bounding_box())), lattice, d.worst_missing,
+             d.worst_missing_at);
+  constexpr double kSlack = 1e-9;  // mm: a distance equal to the tolerance is within it
+  d.within_tolerance = d.worst_out <= tolerance + kSlack && d.worst_missing <= tolerance + kSlack;
   return d;
+}
+
+namespace {
+
+std::string direction_text(const char* name, double worst, const std::optional<geometry::Vec3>& at, double tolerance) {
+  if (std::isinf(worst)) return std::string(name) + " everything (nothing made)";
+  std::string s = std::string(name) + " " + fixed_number(worst, 2) + " mm";
+  if (at && worst > tolerance)
+    s += " at (" + fixed_number(at->x, 2) + ", " + fixed_number(at->y, 2) + ", " + fixed_number(at->z, 2) + ")";
+  return s;
+}
+
+}  // namespace
+
+std::string deviation_text(const Deviation& d, double tolerance) {
+  return fixed_number(d.over_volume, 1) + " mm\u00B3 over, " + fixed_number(d.under_volume, 1) + " mm\u00B3 under; " +
+         direction_text("out", d.worst_out, d.worst_out_at, tolerance) + ", " +
+         direction_text("missing", d.worst_missing, d.worst_missing_at, tolerance) + ": " +
+         (d.within_tolerance ? "within" : "OUTSIDE") + " tolerance (" + shortest_number(tolerance) + " mm)";
 }
 
 }  // namespace hybridctl::planner

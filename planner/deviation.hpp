@@ -1,8 +1,29 @@
 #pragma once
-// How far a made solid is from the design: the material outside it, the design left
-// empty, and how deep each goes, against the tolerance. One measure for the planner's
+// How far a made solid M is from the design D, both ways: one measure for the planner's
 // plans (plan.json's `deviation`, docs/plan-format.md) and for what a run built
-// (`hybridctl dry-run`).
+// (`hybridctl dry-run`, validation by execution).
+//
+// M is within the tolerance t of D when every point of M's surface is within t of D's
+// surface and every point of D's surface within t of M's (the two-sided Hausdorff
+// distance of the surfaces). On voxels: a voxel stands for the cube around its centre and
+// a surface is the faces between material and air. Every point of M's surface that is
+// not on D's lies on a voxel where M and D differ, and so does every point of D's that is
+// not on M's; a wrong voxel whose centre is e from the nearest voxel centre across a
+// surface reaches at most e from it (exactly e along an axis). So:
+//
+//   worst_out      the largest such e from D's other side over the voxels where M and D
+//                  differ: bounds how far M's surface gets from D's, and how deep wrong
+//                  material or a wrong hole goes (which catches a filled internal channel);
+//   worst_missing  the largest such e from M's other side: bounds how far D's surface gets
+//                  from M's (a missing fin: its tip from the plate left; a filled slot:
+//                  its floor from the surface over it).
+//
+// Both at most t is `within_tolerance`. The half-voxel convention: one layer of voxels
+// too many or too few is one voxel (h) off both ways. The older fields `worst_over` and
+// `worst_under` keep their meaning, the depth of the wrong voxel's centre, h/2 less.
+
+#include <optional>
+#include <string>
 
 #include "geometry/solid.hpp"
 
@@ -11,16 +32,24 @@ namespace hybridctl::planner {
 struct Deviation {
   double over_volume = 0;     // mm^3 of material outside the design
   double under_volume = 0;    // mm^3 of the design left empty
-  double worst_over = 0;      // mm: the farthest voxel outside the design from its surface
-  double worst_under = 0;     // mm: the farthest empty voxel of the design from its surface
+  double worst_over = 0;      // mm: the centre of the farthest voxel outside the design from its surface
+  double worst_under = 0;     // mm: the centre of the farthest empty voxel of the design from its surface
   double worst_distance = 0;  // mm: the larger of the two
-  bool within_tolerance = false;
+  double worst_out = 0;       // mm: M's surface (and wrong material or holes) from D's surface
+  std::optional<geometry::Vec3> worst_out_at;      // mm, part frame: the voxel centre where
+  double worst_missing = 0;   // mm: D's surface from M's surface; infinite when M is empty
+  std::optional<geometry::Vec3> worst_missing_at;  // mm, part frame: the voxel centre where
+  bool within_tolerance = false;  // worst_out and worst_missing both at most the tolerance
 };
 
-// `made` and `design` on one lattice; `domain` bounds the air around the design.
-// Distances are between voxel centres less half a voxel: the distance to the surface
-// between the voxels.
+// `made` and `design` on one lattice. Everything outside `made` is air, also beyond
+// `domain` (kept for callers; the distances do not depend on it).
 Deviation measure_deviation(const geometry::Solid& made, const geometry::Solid& design,
                             const geometry::IndexBox& domain, double tolerance);
+
+// One line for people, as `plan` and `dry-run` print it: volumes over and under, both
+// directions (with where, when beyond the tolerance), and "within tolerance" only when
+// both hold.
+std::string deviation_text(const Deviation& d, double tolerance);
 
 }  // namespace hybridctl::planner

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -40,6 +41,23 @@ json atom_ids(const AtomSet& set, int atoms) {
 }
 
 std::string fixed(double v, int digits) { return fixed_number(v, digits); }
+
+// A distance that may be infinite (nothing made) and a place that may be absent: null.
+json distance_json(double mm) { return std::isfinite(mm) ? json(mm) : json(nullptr); }
+json place_json(const std::optional<geometry::Vec3>& at) { return at ? vec(*at) : json(nullptr); }
+
+json deviation_json(const Deviation& d) {
+  return {{"over_volume", d.over_volume},
+          {"under_volume", d.under_volume},
+          {"worst_over", d.worst_over},
+          {"worst_under", d.worst_under},
+          {"worst_distance", d.worst_distance},
+          {"worst_out", distance_json(d.worst_out)},
+          {"worst_out_at", place_json(d.worst_out_at)},
+          {"worst_missing", distance_json(d.worst_missing)},
+          {"worst_missing_at", place_json(d.worst_missing_at)},
+          {"within_tolerance", d.within_tolerance}};
+}
 
 }  // namespace
 
@@ -148,11 +166,7 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
                      {"cost", plan.cost},
                      {"file", "plans/plan-" + std::to_string(k + 1) + ".vdb"},
                      {"final_atoms", atom_ids(plan.final_state, r.atoms.atom_count())},
-                     {"deviation",
-                      {{"over_volume", d.over_volume},
-                       {"under_volume", d.under_volume},
-                       {"worst_distance", d.worst_distance},
-                       {"within_tolerance", d.within_tolerance}}},
+                     {"deviation", deviation_json(d)},
                      {"actions", actions}});
   }
   doc["plans"] = plans;
@@ -245,9 +259,7 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
       const Plan& plan = r.plans[k];
       const Deviation& d = r.deviations[k];
       os << "  " << (k + 1) << ". " << expression(r.problem, plan) << "  cost " << fixed(plan.cost, 4) << "\n";
-      os << "     deviation: " << fixed(d.over_volume, 1) << " mm\u00B3 over, " << fixed(d.under_volume, 1)
-         << " mm\u00B3 under, worst " << fixed(d.worst_distance, 2) << " mm ("
-         << (d.within_tolerance ? "within" : "OUTSIDE") << " tolerance)\n";
+      os << "     deviation: " << deviation_text(d, r.tolerance) << "\n";
       for (std::size_t s = 0; s < plan.steps.size(); ++s) {
         const PlanStep& st = plan.steps[s];
         const Primitive& p = r.primitives[std::size_t(st.primitive)];
