@@ -1,5 +1,7 @@
 #include "planner/atoms.hpp"
 
+#include "planner/thin_parts.hpp"
+
 #include <tbb/blocked_range.h>
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
@@ -9,7 +11,6 @@
 #include <stdexcept>
 #include <unordered_map>
 
-#include "geometry/morphology.hpp"
 
 namespace hybridctl::planner {
 namespace {
@@ -176,6 +177,15 @@ bool same_partition(const AtomDecomposition& a, const AtomDecomposition& b) {
   return true;
 }
 
+AtomClass class_of(const AtomMeasures& a) {
+  const bool in = a.voxels_in_core > 0 || a.thin_feature, out = a.voxels_beyond_hull > 0 || a.thin_gap;
+  return a.sliver ? AtomClass::Free
+         : in && out ? AtomClass::Violating
+         : in        ? AtomClass::MustIn
+         : out       ? AtomClass::MustOut
+                     : AtomClass::Free;
+}
+
 const char* to_string(AtomClass c) {
   switch (c) {
     case AtomClass::MustIn: return "must-in";
@@ -184,12 +194,6 @@ const char* to_string(AtomClass c) {
     case AtomClass::Violating: return "violating";
   }
   return "?";
-}
-
-ToleranceZone make_tolerance_zone(const Solid& design, double tolerance_mm) {
-  if (tolerance_mm <= 0) return {design, design};
-  const geometry::Ball ball{tolerance_mm};
-  return {geometry::erode(design, ball), geometry::dilate(design, ball)};
 }
 
 std::vector<AtomMeasures> measure_atoms(const AtomDecomposition& atoms, const Solid& design, const ToleranceZone& zone,
@@ -265,13 +269,9 @@ std::vector<AtomMeasures> measure_atoms(const AtomDecomposition& atoms, const So
                     a.centroid.z + s.z / double(a.voxels) * h};
     }
     a.sliver = a.volume < sliver_threshold_mm3;
-    const bool in = a.voxels_in_core > 0, out_ = a.voxels_beyond_hull > 0;
-    a.atom_class = a.sliver ? AtomClass::Free
-                   : in && out_ ? AtomClass::Violating
-                   : in         ? AtomClass::MustIn
-                   : out_       ? AtomClass::MustOut
-                                : AtomClass::Free;
+    a.atom_class = class_of(a);
   }
+  mark_thin_parts(atoms, design, zone, out);
   return out;
 }
 

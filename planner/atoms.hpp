@@ -13,6 +13,7 @@
 
 #include "geometry/solid.hpp"
 #include "planner/atom_set.hpp"
+#include "planner/tolerance_zone.hpp"
 
 namespace hybridctl::planner {
 
@@ -64,11 +65,13 @@ class AtomDecomposition {
   std::vector<std::int32_t> labels_;  // atom per domain voxel, x fastest
 };
 
-// What an atom is to the design, given the tolerance zone (section 6, relaxed): a
-// must-in atom reaches the design shrunk by the tolerance, a must-out atom reaches the
-// outside of the design grown by the tolerance, a violating atom does both, and a free
-// atom lies wholly in the tolerance band. Slivers (below the volume threshold) are
-// discretization noise and count as free.
+// What an atom is to the design, given the tolerance zone (section 6, relaxed; two-sided,
+// planner/tolerance_zone.hpp): a must-in atom reaches the design shrunk by the tolerance
+// or is needed to keep a thin feature (planner/thin_parts.hpp), a must-out atom reaches
+// beyond the design grown by the tolerance or is needed to keep a narrow gap open, a
+// violating atom is both, and a free atom neither. Slivers (below the volume threshold)
+// are discretization noise and count as free: the one case where an outcome that
+// respects the classes may still be outside the tolerance.
 enum class AtomClass { MustIn, MustOut, Free, Violating };
 const char* to_string(AtomClass c);
 
@@ -78,6 +81,8 @@ struct AtomMeasures {
   std::int64_t voxels_in_design = 0;
   std::int64_t voxels_in_core = 0;     // inside the design shrunk by the tolerance
   std::int64_t voxels_beyond_hull = 0; // outside the design grown by the tolerance
+  bool thin_feature = false;  // kept so that a feature thinner than twice the tolerance is (planner/thin_parts.hpp)
+  bool thin_gap = false;      // left empty so that a gap narrower than twice the tolerance is
   double volume = 0;                   // mm^3
   double volume_in_design = 0;         // mm^3
   IndexBox bounding_box;
@@ -86,13 +91,10 @@ struct AtomMeasures {
   bool sliver = false;
 };
 
-// The design shrunk and grown by the tolerance (balls of the tolerance radius).
-struct ToleranceZone {
-  Solid core;  // design (-) ball
-  Solid hull;  // design (+) ball
-};
-ToleranceZone make_tolerance_zone(const Solid& design, double tolerance_mm);
+// The class from the measures and flags above.
+AtomClass class_of(const AtomMeasures& m);
 
+// Measures and classifies every atom, thin features and gaps included.
 std::vector<AtomMeasures> measure_atoms(const AtomDecomposition& atoms, const Solid& design, const ToleranceZone& zone,
                                         double sliver_threshold_mm3);
 

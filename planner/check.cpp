@@ -12,11 +12,21 @@ std::string format(const char* fmt, double a, double b = 0, double c = 0) {
   return buf;
 }
 
+// Why a plan must keep the atom and why it must not.
+std::string reasons(const ViolatingAtom& v) {
+  auto both = [](std::string a, const std::string& b) { return a.empty() ? b : b.empty() ? a : a + "; " + b; };
+  const std::string keep = both(v.holds_core ? "it holds design deeper than the tolerance" : "",
+                                v.holds_thin_feature ? "a feature thinner than twice the tolerance needs it" : "");
+  const std::string drop = both(v.beyond_hull ? "it reaches farther than the tolerance outside the design" : "",
+                                v.holds_thin_gap ? "a gap narrower than twice the tolerance needs it empty" : "");
+  return "it must be kept (" + keep + ") and must not be (" + drop + ")";
+}
+
 std::string describe(const PlanningProblem& p, const ViolatingAtom& v) {
   std::string s = "a " + format("%.3g", v.volume) + " mm\u00B3 region around " +
                   format("(%.1f, %.1f, %.1f)", v.centroid.x, v.centroid.y, v.centroid.z) + " mm, " +
                   format("%.3g", v.volume_in_design) + " mm\u00B3 of it inside the design and " +
-                  format("%.3g", v.volume - v.volume_in_design) + " mm\u00B3 outside; ";
+                  format("%.3g", v.volume - v.volume_in_design) + " mm\u00B3 outside; " + reasons(v) + "; ";
   bool any_additive = false, any_subtractive = false;
   std::string names;
   for (int i : v.primitives) {
@@ -105,6 +115,10 @@ Verdict check_manufacturability(const PlanningProblem& p, const std::vector<Atom
     va.volume_in_design = m.volume_in_design;
     va.bounds = lattice.extent(m.bounding_box);
     va.centroid = m.centroid;
+    va.holds_core = m.voxels_in_core > 0;
+    va.holds_thin_feature = m.thin_feature;
+    va.beyond_hull = m.voxels_beyond_hull > 0;
+    va.holds_thin_gap = m.thin_gap;
     va.description = describe(p, va);
     v.violations.push_back(std::move(va));
   }

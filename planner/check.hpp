@@ -19,6 +19,11 @@ struct ViolatingAtom {
   double volume_in_design = 0;      // mm^3
   geometry::Box3 bounds;            // mm
   Vec3 centroid;                    // mm
+  // Why it must be kept and why it must not be (planner/tolerance_zone.hpp).
+  bool holds_core = false;          // design deeper than the tolerance
+  bool holds_thin_feature = false;  // needed to keep a feature thinner than twice the tolerance
+  bool beyond_hull = false;         // air farther than the tolerance from the design
+  bool holds_thin_gap = false;      // needed to keep a gap narrower than twice the tolerance open
   std::string description;          // one sentence for people
 };
 

@@ -46,6 +46,16 @@ std::string fixed(double v, int digits) { return fixed_number(v, digits); }
 json distance_json(double mm) { return std::isfinite(mm) ? json(mm) : json(nullptr); }
 json place_json(const std::optional<geometry::Vec3>& at) { return at ? vec(*at) : json(nullptr); }
 
+// What in the tolerance zone an atom holds (planner/tolerance_zone.hpp), which decides its class.
+json class_reasons(bool core, bool thin_feature, bool beyond_hull, bool thin_gap) {
+  json r = json::array();
+  if (core) r.push_back("core");
+  if (thin_feature) r.push_back("thin-feature");
+  if (beyond_hull) r.push_back("beyond-hull");
+  if (thin_gap) r.push_back("thin-gap");
+  return r;
+}
+
 json deviation_json(const Deviation& d) {
   return {{"over_volume", d.over_volume},
           {"under_volume", d.under_volume},
@@ -116,6 +126,7 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
                      {"volume", m.volume},
                      {"volume_in_design", m.volume_in_design},
                      {"class", to_string(m.atom_class)},
+                     {"reasons", class_reasons(m.voxels_in_core > 0, m.thin_feature, m.voxels_beyond_hull > 0, m.thin_gap)},
                      {"sliver", m.sliver},
                      {"bounding_box", box_json(r.lattice.extent(m.bounding_box))},
                      {"centroid", vec(m.centroid)}});
@@ -133,6 +144,7 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
                           {"volume_in_design", v.volume_in_design},
                           {"bounding_box", box_json(v.bounds)},
                           {"centroid", vec(v.centroid)},
+                          {"reasons", class_reasons(v.holds_core, v.holds_thin_feature, v.beyond_hull, v.holds_thin_gap)},
                           {"description", v.description}});
   }
   doc["verdict"] = {{"manufacturable", r.verdict.manufacturable},

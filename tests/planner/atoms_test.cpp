@@ -7,6 +7,8 @@
 
 #include "geometry/shapes.hpp"
 #include "planner/atoms.hpp"
+#include "planner/deviation.hpp"
+#include "planner_fixtures.hpp"
 
 namespace hybridctl::planner {
 namespace {
@@ -121,6 +123,50 @@ TEST(Atoms, AnAtomStraddlingTheDesignBeyondToleranceIsViolating) {
   // As a sliver it would be noise.
   const auto lenient = measure_atoms(atoms, design, make_tolerance_zone(design, 1.0), 1e6);
   EXPECT_EQ(lenient[std::size_t(atoms.atom_at({12, 12, 8}))].atom_class, AtomClass::Free);
+}
+
+// Thin features and gaps (planner/tolerance_zone.hpp). A plate with a fin one voxel
+// thick, from two depositions: the fin has no core, so with the core and hull alone its
+// atom was free and the plate alone a goal, 12 voxels short at the fin's tip.
+TEST(Atoms, AThinFinIsMustInSoAPlanWithoutItIsNoGoal) {
+  const IndexBox domain{{0, 0, 0}, {32, 32, 24}};
+  const Solid plate = make_box(kLattice, {{4, 4, 2}, {28, 28, 5}}), fin = make_box(kLattice, {{14, 6, 5}, {15, 26, 17}});
+  const Solid design = unite(plate, fin);
+  const auto vp = testing::make_problem(
+      {{"plate", Mode::Additive, false, 1.0, plate}, {"fin", Mode::Additive, false, 5.0, fin}}, design, domain, 1.0);
+  const int fin_atom = vp.atoms.atom_at({14, 10, 10});
+  EXPECT_EQ(vp.measures[std::size_t(fin_atom)].atom_class, AtomClass::MustIn);
+  const ToleranceZone zone = make_tolerance_zone(design, 1.0);
+  const auto core_and_hull_only =
+      measure_atoms(vp.atoms, design, {zone.core, zone.hull, Solid(kLattice, {}), Solid(kLattice, {})}, 0.0);
+  EXPECT_EQ(core_and_hull_only[std::size_t(fin_atom)].atom_class, AtomClass::Free);
+  EXPECT_FALSE(is_goal(vp.problem, vp.problem.primitives[0].atoms));
+  const std::vector<Plan> plans = find_plans(vp.problem);
+  ASSERT_FALSE(plans.empty());
+  for (const Plan& plan : plans) {
+    const Solid made = testing::evaluate(vp, plan);
+    EXPECT_TRUE(subtract(fin, made).empty()) << expression(vp.problem, plan);
+    EXPECT_TRUE(measure_deviation(made, design, domain, 1.0).within_tolerance) << expression(vp.problem, plan);
+  }
+}
+
+// A block with a slot one voxel wide, from a stock and a removal: the slot lies wholly
+// in the hull, so it was free and the stock alone a goal.
+TEST(Atoms, ANarrowSlotIsMustOutSoAPlanThatFillsItIsNoGoal) {
+  const IndexBox domain{{0, 0, 0}, {32, 32, 20}};
+  const Solid block = make_box(kLattice, {{4, 4, 2}, {28, 28, 14}}), slot = make_box(kLattice, {{14, 4, 5}, {15, 28, 14}});
+  const Solid design = subtract(block, slot);
+  const auto vp = testing::make_problem(
+      {{"stock", Mode::Additive, true, 0.0, block}, {"mill", Mode::Subtractive, false, 1.0, slot}}, design, domain, 1.0);
+  EXPECT_EQ(vp.measures[std::size_t(vp.atoms.atom_at({14, 10, 10}))].atom_class, AtomClass::MustOut);
+  EXPECT_FALSE(is_goal(vp.problem, vp.problem.primitives[0].atoms));
+  const std::vector<Plan> plans = find_plans(vp.problem);
+  ASSERT_FALSE(plans.empty());
+  for (const Plan& plan : plans) {
+    const Solid made = testing::evaluate(vp, plan);
+    EXPECT_TRUE(intersect(slot, made).empty()) << expression(vp.problem, plan);
+    EXPECT_TRUE(measure_deviation(made, design, domain, 1.0).within_tolerance) << expression(vp.problem, plan);
+  }
 }
 
 }  // namespace

@@ -82,5 +82,24 @@ TEST(Check, HybridSetsWithoutViolationsGoToTheSearch) {
   EXPECT_TRUE(v.violations.empty());
 }
 
+// A fin one voxel thick that only a deposition three voxels too wide reaches: its atom
+// holds the fin (thinner than twice the tolerance) and air beyond the hull.
+TEST(Check, AThinFeatureOnlyAnOverfillReachesIsAViolationThatSaysSo) {
+  const IndexBox domain{{0, 0, 0}, {32, 32, 24}};
+  const Solid plate = make_box(kUnit, {{4, 4, 2}, {28, 28, 5}}), fin = make_box(kUnit, {{14, 6, 5}, {15, 26, 17}});
+  const Solid wide = make_box(kUnit, {{11, 6, 5}, {18, 26, 17}});
+  const Solid design = unite(plate, fin);
+  const auto vp = make_problem({{"plate", Mode::Additive, false, 1.0, plate}, {"wide", Mode::Additive, false, 1.0, wide}},
+                               design, domain, 1.0);
+  const Verdict v = check_manufacturability(vp.problem, vp.measures, kUnit);
+  EXPECT_FALSE(v.manufacturable);
+  ASSERT_EQ(v.violations.size(), 1u);
+  EXPECT_TRUE(v.violations[0].holds_thin_feature);
+  EXPECT_TRUE(v.violations[0].beyond_hull);
+  EXPECT_FALSE(v.violations[0].holds_core);
+  EXPECT_NE(v.violations[0].description.find("a feature thinner than twice the tolerance needs it"), std::string::npos)
+      << v.violations[0].description;
+}
+
 }  // namespace
 }  // namespace hybridctl::planner

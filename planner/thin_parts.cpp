@@ -1,0 +1,103 @@
+#include "planner/thin_parts.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
+#include "geometry/distance_field.hpp"
+#include "geometry/morphology.hpp"
+
+namespace hybridctl::planner {
+namespace {
+
+enum class Side { Material, Air };
+
+// An atom every goal outcome holds (material), or leaves empty (air).
+bool holds(const AtomMeasures& m) { return !m.sliver && (m.atom_class == AtomClass::MustIn || m.atom_class == AtomClass::Violating); }
+bool clears(const AtomMeasures& m) { return !m.sliver && (m.atom_class == AtomClass::MustOut || m.atom_class == AtomClass::Violating); }
+
+// The voxels of `region`, those farthest from the other side first (ties in z, y, x
+// order), and the distance field that ordered them: it spans `region` grown by `reach`
+// voxels, where every candidate for covering a voxel lies.
+struct DeepestFirst {
+  std::vector<Index3> voxels;
+  geometry::DistanceField depth;
+};
+DeepestFirst deepest_first(const Solid& region, const Solid& design, Side side, int reach) {
+  const IndexBox b = region.bounding_box();
+  const IndexBox box{{b.lo.x - reach, b.lo.y - reach, b.lo.z - reach}, {b.hi.x + reach, b.hi.y + reach, b.hi.z + reach}};
+  const Solid other = side == Side::Material ? complement(design, box) : intersect(design, Solid::filled(design.lattice(), box));
+  DeepestFirst d{{}, geometry::DistanceField(other, box)};
+  std::vector<std::pair<float, Index3>> order;
+  region.for_each_voxel([&](Index3 v) { order.push_back({d.depth.squared(v), v}); });
+  std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+  for (const auto& [depth, v] : order) d.voxels.push_back(v);
+  return d;
+}
+
+// Makes every voxel of `region` lie within the ball of an atom that holds it (material)
+// or clears it (air), choosing atoms as planner/thin_parts.hpp says. `pending` tracks
+// the voxels of `region` no chosen voxel covers yet, to prefer a candidate that covers
+// many; atoms that were must-in (must-out) before cover too, which the scan finds.
+void cover(const AtomDecomposition& atoms, const Solid& design, const Solid& region, Side side, double tolerance,
+           std::vector<AtomMeasures>& m) {
+  if (region.empty()) return;
+  const double h = design.voxel_size();
+  const std::vector<Index3> offsets = geometry::offsets_of(geometry::Ball{tolerance}, h);
+  const DeepestFirst order = deepest_first(region, design, side, int(std::floor(tolerance / h)) + 1);
+  const IndexBox& domain = atoms.domain();
+  const bool material = side == Side::Material;
+  Solid pending = region;
+  auto around = [&](Index3 c, auto fn) {
+    for (const Index3& d : offsets) fn(Index3{c.x + d.x, c.y + d.y, c.z + d.z});
+  };
+  for (const Index3& u : order.voxels) {
+    if (!pending.contains(u) || !domain.contains(u)) continue;  // outside the domain nothing is ever made
+    bool covered = false;
+    for (const Index3& d : offsets) {
+      const Index3 v{u.x + d.x, u.y + d.y, u.z + d.z};
+      const bool beyond = !domain.contains(v);
+      if ((beyond && !material) || (!beyond && (material ? holds : clears)(m[std::size_t(atoms.atom_at(v))]))) {
+        covered = true;  // air beyond the domain stays air
+        break;
+      }
+    }
+    if (covered) continue;
+    // Candidates lie on u's side. Rather a free atom than a sliver (not relied on),
+    // rather a sliver than making an atom violating; then the one covering the most
+    // pending voxels, then the deepest (the medial core).
+    std::tuple<int, int, float> best{-1, 0, 0};
+    Index3 chosen{};
+    around(u, [&](Index3 v) {
+      if (!domain.contains(v) || design.contains(v) != material) return;
+      const AtomMeasures& a = m[std::size_t(atoms.atom_at(v))];
+      const int tier = a.sliver ? 1 : (material ? clears(a) : holds(a)) ? 0 : 2;
+      int gain = 0;
+      around(v, [&](Index3 w) { gain += pending.contains(w); });
+      const std::tuple<int, int, float> score{tier, gain, order.depth.squared(v)};
+      if (score > best) {
+        best = score;
+        chosen = v;
+      }
+    });
+    if (std::get<0>(best) < 0) continue;
+    AtomMeasures& a = m[std::size_t(atoms.atom_at(chosen))];
+    (material ? a.thin_feature : a.thin_gap) = true;
+    a.atom_class = class_of(a);
+    if (!a.sliver)
+      around(chosen, [&](Index3 w) {
+        if (pending.contains(w)) pending.set(w, false);
+      });
+  }
+}
+
+}  // namespace
+
+void mark_thin_parts(const AtomDecomposition& atoms, const Solid& design, const ToleranceZone& zone,
+                     std::vector<AtomMeasures>& measures) {
+  if (zone.tolerance <= 0) return;
+  cover(atoms, design, zone.thin, Side::Material, zone.tolerance, measures);
+  cover(atoms, design, zone.narrow, Side::Air, zone.tolerance, measures);
+}
+
+}  // namespace hybridctl::planner
