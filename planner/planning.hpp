@@ -31,6 +31,8 @@ struct PlanningOptions {
   int top_k = 0;
   int max_uses = 1;
   std::int64_t max_expansions = 5'000'000;
+  // Wall-clock budget of the plan search in seconds (SearchOptions::time_limit; 0: none).
+  double search_time = 0;
   std::vector<PrimitiveFile> extra_primitives;
   // Bytes planning may take (planner/memory_estimate.hpp); 0: half the physical memory.
   std::uint64_t memory_budget = 0;
