@@ -82,6 +82,7 @@ class LinuxcncController final : public protocol::ControllerPort {
   void back_after_loss();
   void stop_segment_on_alarm();
   void fail_segment(const std::string& message);
+  bool ended_normally(const LinuxcncStatus& s) const;
   bool finished() const { return acceptor_.has_program() && last_executed_line_ >= acceptor_.line_count(); }
 
   LinuxcncLink& link_;
@@ -101,6 +102,7 @@ class LinuxcncController final : public protocol::ControllerPort {
   std::uint32_t last_executed_line_ = 0, last_executed_chunk_ = 0;
   bool started_ = false, aborted_ = false, prepared_ = false, hold_requested_ = false;
   bool linuxcnc_lost_ = false;
+  std::optional<std::chrono::steady_clock::time_point> idle_early_since_;  // LinuxCNC idle before the segment's end
   LinuxcncStatus last_;
   BridgeReport report_;
 };

@@ -76,10 +76,24 @@ void LinuxcncController::take_messages(const LinuxcncStatus& s) {
 void LinuxcncController::follow_segment(const LinuxcncStatus& s) {
   if (!segment_ || s.file != segment_path_) return;
   if (s.interp_state == LinuxcncStatus::kInterpIdle) {
-    executed_through(segment_->last_line());
-    segment_.reset();
+    if (ended_normally(s)) {
+      executed_through(segment_->last_line());
+      segment_.reset();
+      idle_early_since_.reset();
+      return;
+    }
+    // Idle before the end: an e-stop, an error or an abort at the machine. Its e-stop
+    // flag or error message may come a status or two later; without either, after a
+    // second, it is an alarm of its own.
+    if (!idle_early_since_) idle_early_since_ = now_;
+    if (now_ - *idle_early_since_ > std::chrono::seconds(1)) {
+      idle_early_since_.reset();
+      fail_segment("LinuxCNC stopped the program at file line " + std::to_string(s.current_line) +
+                   " of " + segment_path_ + " without an error (aborted at the machine?)");
+    }
     return;
   }
+  idle_early_since_.reset();
   const std::uint32_t moving = program_line(*segment_, s.motion_line);
   if (moving > 1) executed_through(moving - 1);
   if (s.paused && !hold_requested_ && state_ == ControllerState::Running) {
@@ -99,6 +113,15 @@ void LinuxcncController::follow_segment(const LinuxcncStatus& s) {
       state_ = ControllerState::FeedHold;
     }
   }
+}
+
+// LinuxCNC ran the segment to its end: machine on, its interpreter at the file's last
+// program line, or at a program end (M2/M30) before it.
+bool LinuxcncController::ended_normally(const LinuxcncStatus& s) const {
+  if (s.estop || s.task_state != LinuxcncStatus::kOn) return false;
+  const std::uint32_t at = program_line(*segment_, s.current_line);
+  if (at == 0) return false;
+  return at >= segment_->last_line() || program_end(segment_->lines[at - segment_->first_line]);
 }
 
 void LinuxcncController::executed_through(std::uint32_t line) {
@@ -166,6 +189,7 @@ void LinuxcncController::fail_segment(const std::string& message) {
 // The lines of the segment LinuxCNC did not execute go back to the feeder: a RESUME
 // after RESET_ALARM runs them in a new segment.
 void LinuxcncController::stop_segment_on_alarm() {
+  idle_early_since_.reset();
   if (!segment_) return;
   feeder_.requeue(*segment_, last_executed_line_ + 1);
   segment_.reset();

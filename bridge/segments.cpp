@@ -66,6 +66,16 @@ int stop_code(std::string_view text) {
   return -1;
 }
 
+bool program_end(std::string_view text) {
+  const std::optional<gcode::Block> block = parse(text);
+  if (!block) return false;
+  for (int k = 0; k < block->m_count; ++k) {
+    const int m = block->m[std::size_t(k)].value;
+    if (m == 2 || m == 30) return true;
+  }
+  return false;
+}
+
 bool safe_start(std::string_view text) {
   if (is_percent(text)) return true;
   const std::optional<gcode::Block> block = parse(text);

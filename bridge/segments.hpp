@@ -49,6 +49,9 @@ std::uint32_t outputs_after(std::string_view text, std::uint32_t outputs_before)
 /// 0 for a line with M0 (program stop), 1 for M1 (optional stop), else -1.
 int stop_code(std::string_view text);
 
+/// A line with M2 or M30 (program end).
+bool program_end(std::string_view text);
+
 /// A line a segment may start with: a rapid (G0), a tool change (M6) or a `%` line.
 bool safe_start(std::string_view text);
 

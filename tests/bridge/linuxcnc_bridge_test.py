@@ -120,6 +120,17 @@ class Process:
         return self.proc.returncode
 
 
+def user_processes(wait_s):
+    """The LinuxCNC user's processes still there after up to wait_s seconds (a stopping
+    LinuxCNC takes a few)."""
+    deadline = time.monotonic() + wait_s
+    while True:
+        left = subprocess.run(["pgrep", "-u", USER, "-l", "."], capture_output=True, text=True).stdout.strip()
+        if not left or time.monotonic() > deadline:
+            return left
+        time.sleep(0.2)
+
+
 def linuxcnc_answers():
     probe = "import linuxcnc; s = linuxcnc.stat(); s.poll(); print('up', s.task_state)"
     r = subprocess.run(as_user([PYTHON, "-c", probe]), capture_output=True, text=True, timeout=20)
@@ -130,7 +141,7 @@ class Linuxcnc:
     def __init__(self, ini, work):
         self.ini = ini
         self.work = work
-        leftovers = subprocess.run(["pgrep", "-u", USER, "-l", "."], capture_output=True, text=True).stdout.strip()
+        leftovers = user_processes(15)
         check(not leftovers, "processes of " + USER + " still run (another LinuxCNC?):\n" + leftovers)
         self.process = Process(["timeout", "-k", "10", "900"] + as_user(["linuxcnc", ini]),
                                os.path.join(work, "linuxcnc.log"), cwd=os.path.dirname(ini))
@@ -180,7 +191,7 @@ class Linuxcnc:
         # `halrun -U` unloads whatever is left (rtapi_app is setuid root: it outlives a
         # killed script), then the user's leftover processes go. Else the next start fails.
         subprocess.run(as_user(["halrun", "-U"]), capture_output=True, timeout=60)
-        pids = subprocess.run(["pgrep", "-u", USER], capture_output=True, text=True).stdout.split()
+        pids = [line.split()[0] for line in user_processes(10).splitlines()]
         for pid in pids:
             try:
                 os.kill(int(pid), signal.SIGKILL)

@@ -89,6 +89,9 @@ TEST(SegmentLines, ReadOutputsStopsAndSafeStarts) {
   EXPECT_EQ(stop_code("M01 (check)"), 1);
   EXPECT_EQ(stop_code("M05"), -1);
   EXPECT_EQ(stop_code("M6 T1"), -1);
+  EXPECT_TRUE(program_end("M2"));
+  EXPECT_TRUE(program_end("M30 (end)"));
+  EXPECT_FALSE(program_end("M3 S8000"));
   EXPECT_TRUE(safe_start("G0 Z50"));
   EXPECT_TRUE(safe_start("T2 M6"));
   EXPECT_TRUE(safe_start("%"));
