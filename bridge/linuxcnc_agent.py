@@ -137,6 +137,9 @@ def run(link, path):
     link.command.auto(linuxcnc.AUTO_RUN, 0)
     deadline = time.monotonic() + TIMEOUT_S
     while link.connect().interp_state == linuxcnc.INTERP_IDLE:
+        # AUTO_RUN completes when the program ends: a short one may be over already.
+        if link.command.wait_complete(0.002) == linuxcnc.RCS_DONE and link.connect().file == path:
+            return {"ok": True}
         # A program LinuxCNC refuses at once (a soft limit on its first move) never
         # leaves IDLE: its error says why.
         errors = [m for m in link.drain_errors() if m["error"]]

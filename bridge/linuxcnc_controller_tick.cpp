@@ -116,12 +116,20 @@ void LinuxcncController::follow_segment(const LinuxcncStatus& s) {
 }
 
 // LinuxCNC ran the segment to its end: machine on, its interpreter at the file's last
-// program line, or at a program end (M2/M30) before it.
+// program line, or stopped by a program end (M2/M30). After an M2 LinuxCNC shows the
+// line of the last motion before it (as at an M0, checked on 2.9), so the program end
+// is the first M2/M30 after that line with no move in between.
 bool LinuxcncController::ended_normally(const LinuxcncStatus& s) const {
   if (s.estop || s.task_state != LinuxcncStatus::kOn) return false;
   const std::uint32_t at = program_line(*segment_, s.current_line);
   if (at == 0) return false;
-  return at >= segment_->last_line() || program_end(segment_->lines[at - segment_->first_line]);
+  if (at >= segment_->last_line()) return true;
+  for (std::uint32_t n = at; n <= segment_->last_line(); ++n) {
+    const std::string& text = segment_->lines[n - segment_->first_line];
+    if (program_end(text)) return true;
+    if (n > at && moves(text)) return false;
+  }
+  return false;
 }
 
 void LinuxcncController::executed_through(std::uint32_t line) {

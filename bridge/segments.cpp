@@ -66,6 +66,11 @@ int stop_code(std::string_view text) {
   return -1;
 }
 
+bool moves(std::string_view text) {
+  const std::optional<gcode::Block> block = parse(text);
+  return block && (block->has('X') || block->has('Y') || block->has('Z'));
+}
+
 bool program_end(std::string_view text) {
   const std::optional<gcode::Block> block = parse(text);
   if (!block) return false;

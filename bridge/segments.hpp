@@ -49,6 +49,10 @@ std::uint32_t outputs_after(std::string_view text, std::uint32_t outputs_before)
 /// 0 for a line with M0 (program stop), 1 for M1 (optional stop), else -1.
 int stop_code(std::string_view text);
 
+/// A line with an X, Y or Z word (a move, or an offset that moves nothing: either way
+/// not a line LinuxCNC can have passed silently).
+bool moves(std::string_view text);
+
 /// A line with M2 or M30 (program end).
 bool program_end(std::string_view text);
 

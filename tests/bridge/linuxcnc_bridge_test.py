@@ -278,6 +278,16 @@ def segments_of(bridge_log):
     return [(int(a), int(b)) for a, b in re.findall(r"segment \d+: lines (\d+)\.\.(\d+)", bridge_log)]
 
 
+def check_segments(bridge_log, lines):
+    """LinuxCNC got every line in exactly one segment file, in order: nothing re-run."""
+    segments = segments_of(bridge_log)
+    check(segments and segments[0][0] == 1 and segments[-1][1] == lines and
+          all(b[0] == a[1] + 1 for a, b in zip(segments, segments[1:])),
+          "the segments LinuxCNC ran do not cover lines 1..%d once each: %s\n%s" % (lines, segments, bridge_log[-2000:]))
+    check("alarm" not in bridge_log, "the bridge raised an alarm:\n" + bridge_log[-2000:])
+    return segments
+
+
 def output_changes(program):
     """(line, on) of every M64/M65 P0 in the program, in order."""
     out = []
@@ -412,7 +422,7 @@ def case_modbus(args, ini, plan, faults=()):
         program = program_lines(os.path.join(args.work, "job"))
         ran = executed(line_log)
         check_every_line_once(program, ran)
-        segments = segments_of(log)
+        segments = check_segments(log, len(program))
         print("figure lines %d" % len(program))
         print("figure segments %d" % len(segments))
         print("figure lines_per_second %.0f (%.1f s for the whole run)" % (len(program) / seconds, seconds))
@@ -495,7 +505,9 @@ def run_socketcand(args, ini, plan):
             bridge.stop()
         check(r.returncode == 0, "hybridctl run over socketcand exited %d:\n%s\n%s\nbridge:\n%s" %
               (r.returncode, r.stdout[-3000:], r.stderr[-3000:], bridge.output()[-3000:]))
-        check_every_line_once(program_lines(os.path.join(args.work, "job")), executed(line_log))
+        program = program_lines(os.path.join(args.work, "job"))
+        check_every_line_once(program, executed(line_log))
+        print("figure segments %d" % len(check_segments(bridge.output(), len(program))))
         print("figure socketcand_seconds %.1f" % seconds)
     finally:
         cnc.stop()

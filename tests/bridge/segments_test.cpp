@@ -92,6 +92,8 @@ TEST(SegmentLines, ReadOutputsStopsAndSafeStarts) {
   EXPECT_TRUE(program_end("M2"));
   EXPECT_TRUE(program_end("M30 (end)"));
   EXPECT_FALSE(program_end("M3 S8000"));
+  EXPECT_TRUE(moves("G53 G0 Z300"));
+  EXPECT_FALSE(moves("M5"));
   EXPECT_TRUE(safe_start("G0 Z50"));
   EXPECT_TRUE(safe_start("T2 M6"));
   EXPECT_TRUE(safe_start("%"));
