@@ -81,7 +81,7 @@ protocol::ResultCode LinuxcncController::write_command(const protocol::Command& 
 void LinuxcncController::write_heartbeat(std::uint16_t counter) {
   if (counter == heartbeat_) return;
   heartbeat_ = counter;
-  heartbeat_changed_ = now_;
+  heartbeat_changed_ = std::chrono::steady_clock::now();  // after the calls to LinuxCNC, which may block
 }
 
 protocol::Status LinuxcncController::status() const {
@@ -183,7 +183,7 @@ ResultCode LinuxcncController::start() {
   }
   state_ = ControllerState::Running;
   started_ = true;
-  heartbeat_changed_ = now_;
+  heartbeat_changed_ = std::chrono::steady_clock::now();  // after the calls to LinuxCNC, which may block
   return ResultCode::Accepted;
 }
 
@@ -203,7 +203,7 @@ ResultCode LinuxcncController::resume() {
   }
   hold_requested_ = false;
   state_ = ControllerState::Running;
-  heartbeat_changed_ = now_;
+  heartbeat_changed_ = std::chrono::steady_clock::now();  // after the calls to LinuxCNC, which may block
   return ResultCode::Accepted;
 }
 

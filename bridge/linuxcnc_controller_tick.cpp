@@ -26,6 +26,20 @@ bool program_running(ControllerState s) {
 
 void LinuxcncController::tick(std::chrono::steady_clock::time_point now) {
   now_ = now;
+  // The heartbeat first: the status read below may block (a loaded host), and the
+  // heartbeats that arrive meanwhile are only read after this tick.
+  if (state_ == ControllerState::Running && options_.heartbeat_timeout_s > 0 &&
+      std::chrono::duration<double>(now_ - heartbeat_changed_).count() > options_.heartbeat_timeout_s) {
+    if (segment_) {
+      try {
+        link_.pause();
+      } catch (const LinkError& e) {
+        if (options_.log) options_.log(std::string("feed hold: ") + e.what());
+      }
+    }
+    raise(AlarmCode::HostHeartbeatLost, 0,
+          "no heartbeat change for " + std::to_string(options_.heartbeat_timeout_s) + " s: LinuxCNC paused");
+  }
   LinuxcncStatus s;
   try {
     s = link_.status();
@@ -48,18 +62,6 @@ void LinuxcncController::tick(std::chrono::steady_clock::time_point now) {
   take_messages(s);
   follow_segment(s);
   if (state_ == ControllerState::Running && !segment_) start_next_segment();
-  if (state_ == ControllerState::Running && options_.heartbeat_timeout_s > 0 &&
-      std::chrono::duration<double>(now_ - heartbeat_changed_).count() > options_.heartbeat_timeout_s) {
-    if (segment_) {
-      try {
-        link_.pause();
-      } catch (const LinkError& e) {
-        if (options_.log) options_.log(std::string("feed hold: ") + e.what());
-      }
-    }
-    raise(AlarmCode::HostHeartbeatLost, 0,
-          "no heartbeat change for " + std::to_string(options_.heartbeat_timeout_s) + " s: LinuxCNC paused");
-  }
 }
 
 // LinuxCNC's error channel: an error while a segment runs stops the program (LinuxCNC
