@@ -59,6 +59,25 @@ constexpr std::array<AlarmInfo, kAlarmCodeCount> kAlarms{{
      "Inspect the bead at the stop; RESET_ALARM and RESUME, or ABORT. Send chunks earlier "
      "(keep the buffer fuller) on this transport.",
      true},
+    // 12 and 13 are the simulator's (engineer P's branch brings their full text).
+    {AlarmCode::DepositionOverAir, "DEPOSITION_OVER_AIR",
+     "Deposition at the alarm line would lay a bead over air (nothing below it).", "ABORT; re-export the program.",
+     true},
+    {AlarmCode::NozzleCollision, "NOZZLE_COLLISION",
+     "The deposition nozzle would hit material at the alarm line.", "ABORT; re-export the program.", true},
+    {AlarmCode::LinuxcncError, "LINUXCNC_ERROR",
+     "LinuxCNC reported an error the other codes do not name (its error channel; the bridge "
+     "logs LinuxCNC's message) and stopped the program at the alarm line.",
+     "Read LinuxCNC's message in the bridge's log; fix the cause, RESET_ALARM and RESUME, or "
+     "ABORT.",
+     true},
+    {AlarmCode::LinuxcncLost, "LINUXCNC_LOST",
+     "The LinuxCNC bridge lost LinuxCNC (it stopped or restarted): the program in LinuxCNC, "
+     "its position and modal state are gone. When LinuxCNC is back the bridge counts a new "
+     "boot without the program.",
+     "Check the machine (position, tool, part); the host reports a controller loss and "
+     "the lines that ran; restart with `run --resume DIR --from-line N`.",
+     false},
 }};
 
 constexpr std::array<ResultInfo, kResultCodeCount> kResults{{

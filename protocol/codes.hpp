@@ -58,8 +58,12 @@ enum class AlarmCode : std::uint16_t {
   SpindleDepositionConflict = 9,
   ControllerRestarted = 10,
   DepositionStarved = 11,
+  DepositionOverAir = 12,  // the simulator's (engineer P's branch brings its text)
+  NozzleCollision = 13,    // the simulator's (engineer P's branch brings its text)
+  LinuxcncError = 14,      // the LinuxCNC bridge (docs/bridge.md)
+  LinuxcncLost = 15,       // the LinuxCNC bridge (docs/bridge.md)
 };
-inline constexpr std::uint16_t kAlarmCodeCount = 12;
+inline constexpr std::uint16_t kAlarmCodeCount = 16;
 
 /// Outcome of a chunk write or a command, reported in the status block; also the kind
 /// of every decoding error. Numbers are wire values.
