@@ -6,6 +6,8 @@
 #include <sstream>
 #include <unordered_map>
 
+#include <tbb/parallel_for.h>
+
 #include "common/error.hpp"
 #include "planner/plan_machine.hpp"
 #include "report/report_as_built.hpp"
@@ -94,6 +96,7 @@ class Gatherer {
     plans();
     doc["rejected"] = field(raw_, "rejected", json::array());
     if (!request_.as_built.empty()) as_built_section();
+    mesh_all();
   }
 
  private:
@@ -107,24 +110,43 @@ class Gatherer {
             {"page_bytes", request_.size_budget}};
   }
 
-  // Plans share states (the design, the raw stock, the same deposit), so each distinct
-  // solid is meshed once per budget.
-  json mesh(const geometry::Solid& solid, std::size_t budget, IndexedMesh* keep = nullptr) {
+  // A placeholder for a solid's mesh, filled in by mesh_all(). Plans share states (the
+  // design, the raw stock, the same deposit), so each distinct solid is meshed once per budget.
+  json mesh(const geometry::Solid& solid, std::size_t budget) {
     const std::uint64_t key = solid_hash(solid) ^ (std::uint64_t(budget) * 0x9E3779B97F4A7C15ull);
-    const IndexedMesh* cached = nullptr;
-    for (auto [it, end] = meshes_.equal_range(key); it != end; ++it)
-      if (it->second.budget == budget && it->second.solid == solid) cached = &it->second.mesh;
-    if (!cached) cached = &meshes_.emplace(key, MeshCacheEntry{solid, budget, budget_mesh(solid, budget)})->second.mesh;
-    IndexedMesh m = *cached;
-    data_.triangles += m.triangles();
-    json j = mesh_json(m);
-    if (keep) *keep = std::move(m);
-    return j;
+    for (auto [it, end] = job_index_.equal_range(key); it != end; ++it)
+      if (jobs_[it->second].budget == budget && jobs_[it->second].solid == solid) return {{"mesh_job", it->second}};
+    jobs_.push_back({solid, budget});
+    job_index_.emplace(key, jobs_.size() - 1);
+    return {{"mesh_job", jobs_.size() - 1}};
+  }
+  static std::size_t job_of(const json& placeholder) { return placeholder.at("mesh_job").get<std::size_t>(); }
+
+  // Meshes every distinct solid, in parallel, and puts the meshes where they were asked for.
+  void mesh_all() {
+    std::vector<IndexedMesh> meshes(jobs_.size());
+    tbb::parallel_for(std::size_t(0), jobs_.size(), [&](std::size_t i) { meshes[i] = budget_mesh(jobs_[i].solid, jobs_[i].budget); });
+    fill(data_.document, meshes);
+    data_.design = meshes[design_job_];
+    for (std::size_t i = 0; i < violating_jobs_.size(); ++i) data_.violating.push_back(meshes[violating_jobs_[i]]);
+    for (std::size_t k = 0; k < state_jobs_.size(); ++k)
+      for (const std::size_t job : state_jobs_[k]) data_.plans[k].states.push_back(meshes[job]);
+  }
+  void fill(json& j, const std::vector<IndexedMesh>& meshes) {
+    if (j.is_object() && j.contains("mesh_job")) {
+      const IndexedMesh& m = meshes[job_of(j)];
+      data_.triangles += m.triangles();
+      j = mesh_json(m);
+      return;
+    }
+    if (j.is_structured())
+      for (json& child : j) fill(child, meshes);
   }
 
   void design() {
     json d = field(raw_, "design", json::object());
-    d["mesh"] = mesh(file_.design, request_.budget.design, &data_.design);
+    d["mesh"] = mesh(file_.design, request_.budget.design);
+    design_job_ = job_of(d["mesh"]);
     data_.document["design"] = d;
   }
 
@@ -157,9 +179,8 @@ class Gatherer {
     for (const json& v : violations) ids.push_back(field(v, "atom", -1).get<int>());
     const AtomSolids solids = atom_solids(file_, codes, classes, ids);
     for (std::size_t i = 0; i < violations.size(); ++i) {
-      IndexedMesh kept;
-      violations[i]["mesh"] = mesh(solids.violating[i], request_.budget.violating_atom, &kept);
-      data_.violating.push_back(std::move(kept));
+      violations[i]["mesh"] = mesh(solids.violating[i], request_.budget.violating_atom);
+      violating_jobs_.push_back(job_of(violations[i]["mesh"]));
     }
     verdict["violations"] = violations;
     const std::pair<const char*, const geometry::Solid*> by_class[] = {
@@ -185,30 +206,45 @@ class Gatherer {
     return entry;
   }
 
+  // What each plan needs that takes time, computed for all plans in parallel: its states
+  // and its toolpaths (or why it has none).
+  struct PlanWork {
+    std::vector<geometry::Solid> states;
+    PlanPaths paths;
+    std::string toolpath_error;
+  };
+  std::vector<PlanWork> plan_work() const {
+    std::vector<PlanWork> work(file_.plans.size());
+    tbb::parallel_for(std::size_t(0), work.size(), [&](std::size_t k) {
+      work[k].states = planner::plan_states(file_, file_.plans[k]);
+      try {
+        work[k].paths = plan_paths(file_, file_.plans[k], machine_);
+      } catch (const std::exception& e) {  // the plan is still shown, without its toolpaths
+        work[k].toolpath_error = e.what();
+      }
+    });
+    return work;
+  }
+
   void plans() {
     json out = json::array();
     const json listed = field(raw_, "plans", json::array());
+    std::vector<PlanWork> work = plan_work();
     for (std::size_t k = 0; k < file_.plans.size(); ++k) {
       const planner::PlanFilePlan& plan = file_.plans[k];
       json entry = k < listed.size() ? listed[k] : json::object();
       entry.erase("final_atoms");
+      if (!work[k].toolpath_error.empty()) entry["toolpath_error"] = work[k].toolpath_error;
       const json raw_actions = field(entry, "actions", json::array());
-      const std::vector<geometry::Solid> states = planner::plan_states(file_, plan);
-      PlanPaths paths;
-      try {
-        paths = plan_paths(file_, plan, machine_);
-      } catch (const std::exception& e) {  // the plan is still shown, without its toolpaths
-        entry["toolpath_error"] = e.what();
-      }
+      const PlanPaths& paths = work[k].paths;
       if (k == 0) line_positions_ = paths.line_positions;
       json actions = json::array();
-      PlanView view;
+      state_jobs_.emplace_back();
       double cycle = 0;
       for (std::size_t a = 0; a < plan.actions.size(); ++a) {
         json action = action_entry(a < raw_actions.size() ? raw_actions[a] : json(), plan.actions[a]);
-        IndexedMesh kept;
-        action["state"] = mesh(states.at(a + 1), request_.budget.state, &kept);
-        view.states.push_back(std::move(kept));
+        action["state"] = mesh(work[k].states.at(a + 1), request_.budget.state);
+        state_jobs_.back().push_back(job_of(action["state"]));
         if (a < paths.actions.size()) {
           action["toolpath"] = toolpath_json(paths.actions[a]);
           cycle += paths.actions[a].cycle_s;
@@ -219,8 +255,7 @@ class Gatherer {
       }
       entry["actions"] = actions;
       entry["cycle_s"] = cycle;
-      view.paths = paths.actions;
-      data_.plans.push_back(std::move(view));
+      data_.plans.push_back(PlanView{{}, paths.actions});
       out.push_back(std::move(entry));
     }
     data_.document["plans"] = out;
@@ -234,12 +269,15 @@ class Gatherer {
   planner::PlanFile file_;
   config::Machine machine_;
   std::vector<geometry::Vec3> line_positions_;
-  struct MeshCacheEntry {
+  struct MeshJob {
     geometry::Solid solid;
     std::size_t budget;
-    IndexedMesh mesh;
   };
-  std::unordered_multimap<std::uint64_t, MeshCacheEntry> meshes_;
+  std::vector<MeshJob> jobs_;
+  std::unordered_multimap<std::uint64_t, std::size_t> job_index_;  // by solid_hash and budget
+  std::size_t design_job_ = 0;
+  std::vector<std::size_t> violating_jobs_;
+  std::vector<std::vector<std::size_t>> state_jobs_;  // per plan, per action
 };
 
 void Gatherer::as_built_section() {

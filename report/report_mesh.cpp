@@ -81,11 +81,15 @@ Solid coarsen(const Solid& solid, int factor) {
                        floor_div(box.hi.z - 1, factor) + 1}};
   const int nx = cbox.hi.x - cbox.lo.x, ny = cbox.hi.y - cbox.lo.y;
   std::vector<std::int32_t> counts(std::size_t(cbox.voxel_count()), 0);
-  solid.for_each_voxel([&](Index3 v) {
-    const int cx = floor_div(v.x, factor) - cbox.lo.x, cy = floor_div(v.y, factor) - cbox.lo.y,
-              cz = floor_div(v.z, factor) - cbox.lo.z;
-    ++counts[(std::size_t(cz) * ny + cy) * nx + cx];
-  });
+  for (int z = box.lo.z; z < box.hi.z; ++z)
+    for (int y = box.lo.y; y < box.hi.y; ++y) {
+      const std::size_t row = (std::size_t(floor_div(z, factor) - cbox.lo.z) * ny + (floor_div(y, factor) - cbox.lo.y)) * nx;
+      for (int w = solid.first_word(); w < solid.first_word() + solid.words_per_row(); ++w)
+        for (std::uint64_t bits = solid.word_at(w, y, z); bits; bits &= bits - 1) {
+          const int x = w * Solid::kWordBits + std::countr_zero(bits);
+          ++counts[row + std::size_t(floor_div(x, factor) - cbox.lo.x)];
+        }
+    }
   const int half = (factor * factor * factor + 1) / 2;
   Solid out(coarse, cbox);
   for (int z = 0; z < cbox.hi.z - cbox.lo.z; ++z)
