@@ -186,6 +186,8 @@ def run(cmd):
 def check_common(browser, name, screens):
     """The page loaded without errors, the canvas drew the part, a primitive toggles."""
     check(not browser.console_errors, "%s: console errors: %s" % (name, browser.console_errors))
+    check(browser.evaluate("getComputedStyle(document.getElementById('path-controls')).display") == "none",
+          "%s: the layer slider shows before a toolpath is" % name)
     check(browser.evaluate("hybridctlReport.errors.length") == 0,
           "%s: the page reported errors: %s" % (name, browser.evaluate("hybridctlReport.errors")))
     box = browser.canvas_box()
@@ -221,7 +223,8 @@ def check_bracket(browser, page, screens):
         "     return [a, t.layer_z.length]; } } return null; })()")
     check(card is not None, "bracket: plan 1 has no action with a toolpath of several layers")
     action, layer_count = card
-    check(browser.evaluate("!document.getElementById('path-controls').hidden"), "bracket: no layer slider shown")
+    check(browser.evaluate("getComputedStyle(document.getElementById('path-controls')).display !== 'none'"),
+          "bracket: no layer slider shown")
     all_layers = browser.screenshot(os.path.join(screens, "bracket-toolpath-all-layers.png"))
     browser.evaluate("(() => { const s = document.getElementById('layer-slider'); s.value = 0;"
                      " s.dispatchEvent(new Event('input')); })()")

@@ -17,7 +17,9 @@
 #include "config/machine_loader.hpp"
 #include "geometry/mesh.hpp"
 #include "planner/plan_report.hpp"
+#include "geometry/vdb_file.hpp"
 #include "report/report.hpp"
+#include "report/report_as_built.hpp"
 #include "report/report_data.hpp"
 
 namespace hybridctl::report {
@@ -141,6 +143,35 @@ TEST(Report, ListsEachOffendingAtomOfAPartTheMachineCannotMake) {
     EXPECT_GT(violations[i]["mesh"]["triangles"].get<int>(), 0) << "atom " << violations[i]["atom"] << " has no surface";
   }
   EXPECT_TRUE(fs::exists(dir / "not-makeable-overview.png"));
+}
+
+TEST(Report, SplitsWhatARunBuiltAgainstTheDesignAtTheTolerance) {
+  const fs::path dir = bracket();
+  const planner::PlanFile file = planner::read_plan_file(dir);
+  // A voxel layer too much on the wall's top and a block in the air (both beyond the 0.5 mm
+  // tolerance: a 2 mm voxel is 1 mm from the surface, as measure_deviation counts it), and a
+  // hole in the design.
+  geometry::Solid built = unite(geometry::Solid(file.lattice, file.domain), file.design);
+  const geometry::IndexBox box = file.design.bounding_box();
+  for (int y = box.lo.y; y < box.hi.y; ++y) built.set_run(y, box.hi.z, box.lo.x, box.lo.x + 5);
+  for (int z = box.lo.z; z < box.lo.z + 3; ++z) built.set_run(box.lo.y - 2, z, box.lo.x, box.lo.x + 3);
+  const geometry::Index3 inside{box.lo.x + 2, box.lo.y + 5, box.lo.z + 1};
+  ASSERT_TRUE(file.design.contains(inside));
+  built.set(inside, false);
+  geometry::write_vdb(built, dir / "as-built-test.vdb");
+  const AsBuilt bands = as_built(file, dir / "as-built-test.vdb");
+  EXPECT_EQ(bands.over_within.voxel_count(), 0);
+  EXPECT_EQ(bands.over_beyond.voxel_count(), 5 * (box.hi.y - box.lo.y) + 9);
+  EXPECT_EQ(bands.built.voxel_count(), built.voxel_count());
+  EXPECT_EQ(bands.under_within.voxel_count() + bands.under_beyond.voxel_count(), 1);
+  ReportRequest request;
+  request.plan = dir;
+  request.output = dir / "as-built.html";
+  request.as_built = dir / "as-built-test.vdb";
+  request.snapshots = false;
+  const nlohmann::json data = page_data(slurp(write_report(request).page));
+  EXPECT_DOUBLE_EQ(data["as_built"]["bands"]["over_beyond"]["volume"].get<double>(), bands.over_beyond.volume());
+  EXPECT_GT(data["as_built"]["built"]["triangles"].get<int>(), 0);
 }
 
 TEST(Report, RefusesWhatIsNotAPlanDirectoryAndWritesNothing) {
