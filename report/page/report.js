@@ -261,7 +261,8 @@
     setVisible('violating', true);
     setVisible('violating:frames', true);
     report.framed = id;
-    if (target) frame(target.clone().expandByScalar(Math.max(2, target.getSize(new THREE.Vector3()).length())), 1.2);
+    // Some room around the atom, so its frame and what is next to it show.
+    if (target) frame(target.clone().expandByScalar(Math.max(2, 0.15 * target.getSize(new THREE.Vector3()).length())), 1.1);
     setCaption('Offending atom ' + id);
   }
   function setCaption(text) { document.getElementById('view-caption').textContent = text; }
