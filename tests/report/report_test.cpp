@@ -34,9 +34,24 @@ std::string slurp(const fs::path& p) {
   return s.str();
 }
 
+const fs::path& test_root() {
+  static const fs::path root = fs::temp_directory_path() / ("hybridctl-report-test-" + std::to_string(::getpid()));
+  return root;
+}
+
+// The plans made for these tests go when the program ends.
+class RemoveTestPlans : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(test_root(), ec);
+  }
+};
+const auto* const kRemoveTestPlans = ::testing::AddGlobalTestEnvironment(new RemoveTestPlans);
+
 // Plans the bracket into a fresh directory once per machine.
 fs::path plan_directory(const std::string& name, const std::string& machine_text) {
-  static const fs::path root = fs::temp_directory_path() / ("hybridctl-report-test-" + std::to_string(::getpid()));
+  const fs::path& root = test_root();
   const fs::path dir = root / name;
   if (fs::exists(dir / "plan.json")) return dir;
   fs::create_directories(root);
