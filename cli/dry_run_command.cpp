@@ -17,6 +17,7 @@
 #include "cli/commands.hpp"
 #include "cli/memory_budget.hpp"
 #include "cli/ranges.hpp"
+#include "cli/report_job.hpp"
 #include "cli/run_job.hpp"
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
@@ -37,6 +38,7 @@ struct DryRunArgs {
   double voxel = 0;
   std::string memory_budget;
   double time_scale = 0;
+  bool report = false;
 };
 
 // `hybridctl sim serve` as a child process; killed when this goes out of scope.
@@ -156,6 +158,14 @@ int run_dry_run(const DryRunArgs& a) {
               built_here.volume(), planned_shape.volume(), extra.volume(), missing.volume());
   std::printf("vs design   %s\n", planner::deviation_text(d, file.tolerance).c_str());
   std::printf("wrote       %s: plan/, job/, as-built.vdb, sim-report.json, executed-lines.ngc\n", out.c_str());
+  if (a.report) {
+    report::ReportRequest request;
+    request.plan = plan_dir;
+    request.output = out / "report.html";
+    request.as_built = as_built;
+    request.run_report = report;
+    write_job_report(request);
+  }
   return kSuccess;
 }
 
@@ -172,6 +182,8 @@ void add_dry_run_command(CLI::App& app, Runner& runner) {
   cmd->add_option("-o,--output", a->output, "Directory for the plan, the job and the simulator's output")->capture_default_str();
   cmd->add_option("--voxel", a->voxel, "Voxel size in mm (default: the machine file's)")->check(greater_than(0));
   add_memory_budget_option(cmd, a->memory_budget);
+  cmd->add_flag("--report", a->report,
+                "Also write the job report with what the run built and its alarms, DIR/report.html and its PNG snapshots");
   cmd->add_option("--time-scale", a->time_scale, "Simulated seconds per real second (0: as fast as possible)")
       ->capture_default_str()
       ->check(at_least(0));
