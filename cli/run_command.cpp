@@ -144,11 +144,11 @@ void print_report(const drivers::JobResult& job) {
   const drivers::StreamCounters& c = r.counters;
   const drivers::TransportCounters& tc = job.transport;
   std::printf("counters    chunks %llu sent, %llu accepted, %llu duplicates, %llu refused; %llu reboots seen, %llu alarms "
-              "cleared, %llu link failures recovered; transport %llu requests, %llu timeouts, %llu retries, %llu reconnects, "
+              "cleared, %llu warnings, %llu link failures recovered; transport %llu requests, %llu timeouts, %llu retries, %llu reconnects, "
               "%llu bad replies\n",
               (unsigned long long)c.chunks_sent, (unsigned long long)c.chunks_accepted, (unsigned long long)c.duplicates,
               (unsigned long long)c.refused, (unsigned long long)c.reboots_seen, (unsigned long long)c.recoveries,
-              (unsigned long long)c.transport_errors, (unsigned long long)tc.requests, (unsigned long long)tc.timeouts,
+              (unsigned long long)c.warnings, (unsigned long long)c.transport_errors, (unsigned long long)tc.requests, (unsigned long long)tc.timeouts,
               (unsigned long long)tc.retries, (unsigned long long)tc.reconnects, (unsigned long long)tc.bad_replies);
 }
 

@@ -237,6 +237,7 @@ StreamCallbacks stream_callbacks(JobOperator& op, ActionTracker& actions, const 
     actions.alarm(s);
     return op.clear_alarm(s);
   };
+  cb.warning = [&actions](const protocol::Status& s) { actions.alarm(s); };
   cb.hold_requested = [&op] { return op.hold_requested(); };
   cb.resume_after_hold = [&op](const protocol::Status& s) { return op.resume_after_hold(s); };
   return cb;

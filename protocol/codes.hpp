@@ -58,8 +58,10 @@ enum class AlarmCode : std::uint16_t {
   SpindleDepositionConflict = 9,
   ControllerRestarted = 10,
   DepositionStarved = 11,
+  DepositionOverAir = 12,
+  NozzleCollision = 13,
 };
-inline constexpr std::uint16_t kAlarmCodeCount = 12;
+inline constexpr std::uint16_t kAlarmCodeCount = 14;
 
 /// Outcome of a chunk write or a command, reported in the status block; also the kind
 /// of every decoding error. Numbers are wire values.
@@ -93,6 +95,9 @@ struct AlarmInfo {
   std::string_view meaning;   ///< what happened
   std::string_view action;    ///< what the operator should do
   bool has_line;              ///< status `alarm_line` names the G-code line at fault
+  /// A warning: the controller reports it (status `alarm`, `alarm_line`) and goes on in
+  /// its state; every other alarm stops the machine in ALARM.
+  bool warning = false;
 };
 
 /// One row of the result-code table.

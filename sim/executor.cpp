@@ -199,11 +199,15 @@ LineOutcome ProgramExecutor::execute_line(std::string_view text, int number) {
     move.line = m.line;
     const MoveReport r = cutter != i.cutters.end() ? i.sim->cut(cutter->second, move) : i.sim->deposit(bead->second, move);
     out.incidents.insert(out.incidents.end(), r.incidents.begin(), r.incidents.end());
-    for (const Incident& inc : r.incidents)
-      if (inc.kind == IncidentKind::RapidIntoMaterial && out.stop == Stop::None) {
-        out.stop = Stop::RapidIntoMaterial;
+    // A crash stops the machine once it has happened; a bead that fell does not (the
+    // controller warns, sim/controller.cpp).
+    for (const Incident& inc : r.incidents) {
+      const bool nozzle = inc.kind == IncidentKind::BodyCollision && bead != i.beads.end();
+      if ((inc.kind == IncidentKind::RapidIntoMaterial || nozzle) && out.stop == Stop::None) {
+        out.stop = nozzle ? Stop::NozzleCollision : Stop::RapidIntoMaterial;
         out.message = where() + describe(inc);
       }
+    }
     if (out.stop != Stop::None) break;
   }
   out.motions = std::move(done);

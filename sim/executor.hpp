@@ -41,6 +41,7 @@ enum class Stop {
   DepositionWithoutHead,      // a deposition code with a cutting tool (or none) in the spindle
   SpindleDepositionConflict,  // spindle and deposition on together
   RapidIntoMaterial,          // a rapid met material (after it happened)
+  NozzleCollision,            // a head's feed move touched material with the nozzle body (after it happened)
 };
 
 struct LineOutcome {

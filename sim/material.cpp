@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <bit>
 #include <climits>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
+
+#include "instruments/support_rule.hpp"
 
 namespace hybridctl::sim {
 namespace {
@@ -127,6 +130,74 @@ void for_each_word(RowMask& mask, geometry::Solid& stock, bool z_descending, Fn&
     }
   }
 }
+
+// Lays a bead's swept voxels (`mask`) on the stock by the head's layer rule
+// (instruments/support_rule.hpp), applied to the bead as one layer of the build: a column
+// of the bead's footprint is held when the rule holds its cell on the material under the
+// bead (the plate below the domain, or any material from one voxel layer below the bead's
+// bottom up to its middle height, what it fuses with); the new voxels of a column not held
+// fell and are counted in `fallen`, not added. The rule's cone and slack are per voxel
+// layer, so a bead taller than a voxel is judged at least as leniently as the planner's
+// layers judge the same deposit; what matters is caught: beads laid over air.
+struct BeadLaying {
+  geometry::Solid& stock;
+  const IndexBox& domain;
+  const instruments::SupportRule& rule;
+  Tally added, overlap, fallen;
+
+  void lay(RowMask& mask) {
+    if (mask.empty()) return;
+    const IndexBox rows = geometry::box_intersection(mask.box, domain);
+    if (rows.empty()) return;
+    // Room around the bead for the cone's reach and a bridge's far anchor.
+    const int reach = int(std::ceil(rule.reach(1))) + rule.max_bridge_voxels + 1;
+    const int gx0 = std::max(domain.lo.x, rows.lo.x - reach), gx1 = std::min(domain.hi.x, rows.hi.x + reach);
+    const int gy0 = std::max(domain.lo.y, rows.lo.y - reach), gy1 = std::min(domain.hi.y, rows.hi.y + reach);
+    instruments::LayerGrid candidates(gx0, gy0, gx1 - gx0, gy1 - gy0), under(gx0, gy0, gx1 - gx0, gy1 - gy0);
+    std::vector<Index3> fresh;  // voxels of the bead not yet material
+    for (int z = rows.lo.z; z < rows.hi.z; ++z)
+      for (int y = rows.lo.y; y < rows.hi.y; ++y) {
+        const std::uint64_t* m = mask.row(y, z);
+        for (int w = std::max(mask.w0, word_of(rows.lo.x)); w < mask.w1; ++w)
+          for (std::uint64_t bits = m[w]; bits; bits &= bits - 1) {
+            const int x = w * kWordBits + std::countr_zero(bits);
+            if (x < rows.lo.x || x >= rows.hi.x) continue;
+            if (stock.contains({x, y, z})) {
+              overlap.add(std::uint64_t{1} << (x - w * kWordBits), w, y, z);
+            } else {
+              fresh.push_back({x, y, z});
+              candidates.set(x, y);
+            }
+          }
+      }
+    if (fresh.empty()) return;
+    const int bottom = mask.box.lo.z, middle = (mask.box.lo.z + mask.box.hi.z - 1) / 2;
+    // The bead is one layer of the build: it looks back one layer, to what it rests on
+    // and fuses with; on the plate it needs nothing.
+    const bool on_plate = bottom - 1 < domain.lo.z;
+    if (!on_plate)
+      for (int y = gy0; y < gy1; ++y)
+        for (int x = gx0; x < gx1; ++x)
+          for (int z = bottom - 1; z <= middle; ++z)
+            if (stock.contains({x, y, z})) {
+              under.set(x, y);
+              break;
+            }
+    const instruments::Below below{1, under};
+    const instruments::LayerGrid held =
+        instruments::supported_cells(candidates, std::span(&below, on_plate ? 0 : 1), under, rule).held;
+    for (const Index3& v : fresh) {
+      const int w = word_of(v.x);
+      const std::uint64_t bit = std::uint64_t{1} << (v.x - w * kWordBits);
+      if (!held.filled(v.x, v.y)) {
+        fallen.add(bit, w, v.y, v.z);
+        continue;
+      }
+      stock.set(v);
+      added.add(bit, w, v.y, v.z);
+    }
+  }
+};
 
 }  // namespace
 
@@ -253,26 +324,18 @@ MoveReport MaterialSimulation::deposit(const Bead& bead, const MaterialMove& mov
             if (!row_inside || w < dw0 || w >= dw1) outside.add(m[w], w, y, z);
         }
     }
-    Tally added, overlap;
-    bool supported = false;
-    auto lay = [&] {
-      // Top rows first, so the row below still holds the material from before the move.
-      for_each_word(bead_mask, stock_, true, [&](int y, int z, int w, std::uint64_t m, std::uint64_t& s) {
-        overlap.add(s & m, w, y, z);
-        added.add(m & ~s, w, y, z);
-        if (!supported)
-          supported = (s & m) != 0 || z == domain_.lo.z || (stock_.word_at(w, y, z - 1) & m) != 0;
-        s |= m;
-      });
-    };
+    const instruments::SupportRule rule = instruments::support_rule(bead.support, stock_.voxel_size());
+    BeadLaying laying{stock_, domain_, rule, {}, {}, {}};
     // The body sits above the bead: fresh material can reach it only on a falling move.
     if (move.to.z < move.from.z) {
-      lay();
+      laying.lay(bead_mask);
       touch(body_mask);
     } else {
       touch(body_mask);
-      lay();
+      laying.lay(bead_mask);
     }
+    const Tally& added = laying.added;
+    const Tally& overlap = laying.overlap;
     out.deposited = double(added.voxels) * v;
     out.overlap = double(overlap.voxels) * v;
     out.outside = double(outside.voxels) * v;
@@ -283,7 +346,7 @@ MoveReport MaterialSimulation::deposit(const Bead& bead, const MaterialMove& mov
       out.collision = double(contact.voxels) * v;
       incident(IncidentKind::BodyCollision, contact);
     }
-    if (!supported) incident(IncidentKind::UnsupportedDeposition, added);
+    incident(IncidentKind::UnsupportedDeposition, laying.fallen);
     incident(IncidentKind::DepositionOutsideDomain, outside);
   } else {
     // Travel: a rapid must keep bead and body out of material, a feed move the body.

@@ -32,7 +32,7 @@ enum class IncidentKind {
   RapidIntoMaterial,        // a rapid touched material (cutter or body; bead or nozzle)
   BodyCollision,            // a feed move touched material with the non-cutting body
   Gouge,                    // a move removed voxels of the protected solid
-  UnsupportedDeposition,    // a bead touched no material and rested on nothing
+  UnsupportedDeposition,    // bead voxels laid over air beyond the head's cone or bridge: they fell, not added
   DepositionOutsideDomain,  // a bead reached beyond the simulated domain: that part is lost
 };
 std::string_view to_string(IncidentKind kind);
@@ -81,8 +81,11 @@ class MaterialSimulation {
   // Moves the cutter: removes what its cutting part sweeps, checks its body. A rapid
   // also cuts (the spindle turns) and reports all material the cutter or body touched.
   MoveReport cut(const Cutter& cutter, const MaterialMove& move);
-  // Moves the head: with the process on, adds what the bead sweeps; otherwise a rapid
-  // reports the material its bead or body would touch, a feed move what its body touches.
+  // Moves the head: with the process on, adds what the bead sweeps where the head's layer
+  // rule holds it (on the plate under the domain, on material under the bead within its
+  // overhang cone, or bridged; docs/simulation.md); what lies over air beyond that falls
+  // and is reported (UnsupportedDeposition). Otherwise a rapid reports the material its bead
+  // or body would touch, a feed move what its body (the nozzle) touches.
   MoveReport deposit(const Bead& bead, const MaterialMove& move);
 
   const geometry::Solid& stock() const { return stock_; }

@@ -272,6 +272,40 @@ TEST(SimServe, WritesTheAsBuiltStockOfAVdbStock) {
   fs::remove_all(dir);
 }
 
+TEST(SimServe, ABeadOverAirIsAWarningOnTheWireAndTheProgramGoesOn) {
+  const fs::path dir = temp_dir("over-air");
+  // A plate, a pillar 8 mm high at x [0, 10], and a post at the far corner so the simulated
+  // world reaches above the pillar; the DED head (T100) lays a track on the pillar's top
+  // from x 2 and on past its edge into the air to x 20 (line 7).
+  const geometry::Lattice lattice{0.5, {0, 0, 0}};
+  geometry::Solid stock = geometry::Solid::filled(lattice, geometry::IndexBox{{0, 0, 0}, {80, 40, 4}});
+  stock = geometry::unite(stock, geometry::Solid::filled(lattice, geometry::IndexBox{{0, 0, 4}, {20, 40, 20}}));
+  stock = geometry::unite(stock, geometry::Solid::filled(lattice, geometry::IndexBox{{76, 36, 4}, {80, 40, 40}}));
+  geometry::write_vdb(stock, dir / "stock.vdb");
+  SimProcess sim(serve_args({"--exit-when-done", "--stock-vdb", (dir / "stock.vdb").string(), "--as-built",
+                             (dir / "built.vdb").string(), "--report", (dir / "run.json").string()}));
+  ModbusClient client(sim.modbus_port());
+  Host host(client, {"G21 G90", "G54", "T100 M6", "G0 X2 Y10 Z30", "G1 Z10 F800", "M64 P0", "G1 X20 F800", "M65 P0",
+                     "G1 Z30 F800", "M2"});
+  ASSERT_EQ(host.command(CommandCode::SetProgram), ResultCode::Accepted);
+  ASSERT_TRUE(host.send_program());
+  ASSERT_EQ(host.command(CommandCode::Start), ResultCode::Accepted);
+  const auto s = host.wait([](const protocol::Status& st) { return st.state == ControllerState::Completed; });
+  ASSERT_TRUE(s.has_value()) << "the program runs to its end";
+  EXPECT_EQ(s->alarm, AlarmCode::DepositionOverAir);
+  EXPECT_EQ(s->alarm_line, 7u);
+  ASSERT_EQ(sim.wait(10s), 0) << sim.errors();
+  const json report = read_json(dir / "run.json");
+  ASSERT_EQ(report["alarms"].size(), 1u) << report["alarms"];
+  EXPECT_EQ(report["alarms"][0].get<std::string>().rfind("line 7: DEPOSITION_OVER_AIR (warning): line 7: unsupported deposition", 0), 0u)
+      << report["alarms"];
+  // What lies over air beyond the pillar's edge (and the cone's reach) was not added.
+  const geometry::Solid added = geometry::subtract(geometry::read_vdb(dir / "built.vdb"), stock);
+  EXPECT_GT(added.volume(), 0);
+  EXPECT_LE(added.bounding_box_mm().max.x, 11.0);
+  fs::remove_all(dir);
+}
+
 TEST(SimServe, TakesTheStockFromAPlan) {
   const fs::path dir = temp_dir("plan-stock");
   const PeerResult plan = run_peer({HYBRIDCTL_EXE, "plan", std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/bracket.stl",
