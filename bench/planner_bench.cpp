@@ -1,7 +1,8 @@
 // Planner benchmarks: atom decomposition at 256^3 with 8 and 32 primitives (incremental
-// splitting against the full recompute), A* on synthetic instances with n = 8..24
-// primitives (expanded states; against the exhaustive enumerator where it finishes), and
-// `plan` end to end on the bracket at 0.5 and 0.25 mm.
+// splitting against the full recompute); the plan search on synthetic instances with
+// n = 8..128 primitives (find_plans, with its gap, against the A* before issue 15 in
+// baseline_astar.cpp and the exhaustive enumerator where they finish); and `plan` end to
+// end on the bracket at 0.5 and 0.25 mm.
 
 #include <benchmark/benchmark.h>
 
@@ -13,6 +14,8 @@
 #include "planner/atoms.hpp"
 #include "planner/planning.hpp"
 #include "planner/search.hpp"
+#include "bench/baseline_astar.hpp"
+#include "bench/plan_problem.hpp"
 
 namespace {
 
@@ -100,26 +103,102 @@ planner::PlanningProblem synthetic_problem(int n, std::uint32_t seed) {
   return p;
 }
 
-// Random instances vary a lot in difficulty: three seeds per size. The search stops at
+// Random instances vary a lot in difficulty: three seeds per size. The baseline stops at
 // 2 million expansions (counter "limit" = 1 then) so the run always ends.
 void BM_AStar(benchmark::State& state) {
   const auto p = synthetic_problem(int(state.range(0)), std::uint32_t(state.range(1)));
   planner::SearchStats stats;
   std::size_t found = 0;
-  for (auto _ : state) found = planner::find_plans(p, {5, 2'000'000}, &stats).size();
+  double cost = 0;
+  for (auto _ : state) {
+    const auto plans = planner::baseline::find_plans(p, {1, 2'000'000}, &stats);
+    found = plans.size();
+    cost = plans.empty() ? 0 : plans.front().cost;
+  }
   state.counters["expanded"] = double(stats.expanded);
   state.counters["plans"] = double(found);
+  state.counters["cost"] = cost;
   state.counters["limit"] = stats.limit_reached ? 1 : 0;
 }
+
+// find_plans as `plan` runs it (one order per block), for the best plan: "exact" = 1 when
+// it is proven optimal, else "gap_pct" is its proven distance from the optimum. The
+// expansion limit (not a time budget) keeps the result the same from run to run.
+void BM_Search(benchmark::State& state) {
+  const auto p = synthetic_problem(int(state.range(0)), std::uint32_t(state.range(1)));
+  planner::SearchOptions options{int(state.range(2)), state.range(3)};
+  options.block_orders = planner::BlockOrders::Cheapest;
+  planner::SearchStats stats;
+  std::vector<planner::Plan> plans;
+  for (auto _ : state) plans = planner::find_plans(p, options, &stats);
+  state.counters["expanded"] = double(stats.expanded);
+  state.counters["plans"] = double(plans.size());
+  state.counters["cost"] = plans.empty() ? 0 : plans.front().cost;
+  state.counters["exact"] = !plans.empty() && plans.front().exact ? 1 : 0;
+  state.counters["gap_pct"] = plans.empty() ? -1 : 100 * plans.front().gap;
+  state.counters["weight"] = stats.weight;
+}
+
+// The search problems of the bundled parts on examples/machines/multitask-b-axis.yaml at
+// 0.5 mm, as `hybridctl plan -o` recorded them (bench/data/README.md): the search stage
+// alone, as `plan` runs it (top 3, one order per block), against the baseline A* (arg 1 = 1;
+// it stops at 300,000 expansions here).
+const char* const kMachineProblems[] = {"bracket", "overhang", "thin-wall-slot", "fins", "slots"};
+
+void BM_SearchMachine(benchmark::State& state) {
+  const std::string part = kMachineProblems[state.range(0)];
+  const auto p = bench::problem_of_plan_json(std::string(HYBRIDCTL_SOURCE_DIR) + "/bench/data/" + part +
+                                             "-b-axis-0.5.problem.json");
+  planner::SearchOptions options{3};
+  options.block_orders = planner::BlockOrders::Cheapest;
+  planner::SearchStats stats;
+  std::vector<planner::Plan> plans;
+  for (auto _ : state) {
+    if (state.range(1) == 1) {
+      plans = planner::baseline::find_plans(p, {3, 300'000}, &stats);
+    } else {
+      plans = planner::find_plans(p, options, &stats);
+    }
+  }
+  state.SetLabel(part + (state.range(1) == 1 ? " baseline" : ""));
+  state.counters["atoms"] = double(p.atoms.size());
+  state.counters["primitives"] = double(p.primitives.size());
+  state.counters["expanded"] = double(stats.expanded);
+  state.counters["plans"] = double(plans.size());
+  state.counters["cost"] = plans.empty() ? 0 : plans.front().cost;
+  state.counters["exact"] = !plans.empty() && plans.front().exact ? 1 : 0;
+  state.counters["gap_pct"] = plans.empty() ? -1 : 100 * plans.front().gap;
+}
+
+BENCHMARK(BM_SearchMachine)
+    ->ArgsProduct({{0, 1, 2, 3, 4}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 void BM_Exhaustive(benchmark::State& state) {
   const auto p = synthetic_problem(int(state.range(0)), std::uint32_t(state.range(1)));
   std::size_t found = 0;
-  for (auto _ : state) found = planner::enumerate_plans(p, 5).size();
+  double cost = 0;
+  for (auto _ : state) {
+    const auto plans = planner::enumerate_plans(p, 5);
+    found = plans.size();
+    cost = plans.empty() ? 0 : plans.front().cost;
+  }
   state.counters["plans"] = double(found);
+  state.counters["cost"] = cost;
 }
 
 BENCHMARK(BM_AStar)->ArgsProduct({{8, 12, 16, 24}, {11, 12, 13}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Search)
+    ->ArgsProduct({{8, 12, 16, 24}, {11, 12, 13}, {1}, {2'000'000}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_Search)
+    ->ArgsProduct({{64, 128}, {11, 12, 13}, {1}, {20'000}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 BENCHMARK(BM_Exhaustive)->ArgsProduct({{8}, {11, 12, 13}})->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_PlanBracket(benchmark::State& state) {

@@ -25,6 +25,7 @@ struct PlanArgs {
   double tolerance = -1;
   int top = 0;
   int reuse = 1;
+  double search_time = 0;
   std::vector<std::string> primitive_files;
 };
 
@@ -46,6 +47,7 @@ int run_plan(const PlanArgs& args) {
   options.tolerance = args.tolerance;
   options.top_k = args.top;
   options.max_uses = args.reuse;
+  options.search_time = args.search_time;
   for (const std::string& p : args.primitive_files) options.extra_primitives.push_back(parse_primitive_argument(p));
   ProgressBar bar("planning");
   std::string current;
@@ -111,6 +113,11 @@ void add_plan_command(CLI::App& app, Runner& runner) {
   cmd->add_option("--reuse", args->reuse, "How often one primitive may appear in a plan")
       ->default_val(1)
       ->check(between(1, 8));
+  cmd->add_option("--search-time", args->search_time,
+                  "Seconds the plan search may take (default: no budget, only its expansion and state limits). "
+                  "Plans the exact search has not proven by half of it come from weighted A*, each with its proven "
+                  "gap; a budget makes the result depend on the machine's speed")
+      ->check(greater_than(0));
   cmd->add_option("--primitive", args->primitive_files,
                   "Extra primitive FILE:am or FILE:sm (STL, or .vdb on the plan's voxel grid); repeatable");
   cmd->callback([&runner, args] { runner = [args] { return run_plan(*args); }; });

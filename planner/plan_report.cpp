@@ -67,6 +67,21 @@ json deviation_json(const Deviation& d) {
           {"worst_missing", distance_json(d.worst_missing)},
           {"worst_missing_at", place_json(d.worst_missing_at)},
           {"within_tolerance", d.within_tolerance}};
+
+// plan.json's `optimality` of the plan at index k (docs/plan-format.md).
+std::string optimality(const Plan& plan, std::size_t k) {
+  if (plan.exact) return k == 0 ? "proven-optimal" : "proven-rank";
+  return std::isfinite(plan.gap) ? "gap" : "unknown";
+}
+
+// The same for people: "proven optimal", "proven 2nd cheapest (+1.2 %)", "within 3.1 % of
+// optimal (proven)".
+std::string optimality_text(const Plan& plan, std::size_t k) {
+  const std::string percent = fixed(100 * plan.gap, plan.gap < 0.1 ? 2 : 1) + " %";
+  if (plan.exact && k == 0) return "proven optimal";
+  if (plan.exact) return "proven rank " + std::to_string(k + 1) + " (" + percent + " above the optimum)";
+  if (!std::isfinite(plan.gap)) return "no proven bound on its distance from the optimum";
+  return "within " + percent + " of optimal (proven)";
 }
 
 }  // namespace
@@ -156,7 +171,9 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
                    {"generated", r.search.generated},
                    {"exhausted", r.search.exhausted},
                    {"limit_reached", r.search.limit_reached},
-                   {"weight", r.search.weight}};
+                   {"weight", r.search.weight},
+                   {"lower_bound", r.search.lower_bound},
+                   {"seconds", r.search.seconds}};
 
   json plans = json::array();
   for (std::size_t k = 0; k < r.plans.size(); ++k) {
@@ -176,6 +193,8 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
     plans.push_back({{"rank", k + 1},
                      {"expression", expression(r.problem, plan)},
                      {"cost", plan.cost},
+                     {"optimality", optimality(plan, k)},
+                     {"gap", std::isfinite(plan.gap) ? json(plan.gap) : json(nullptr)},
                      {"file", "plans/plan-" + std::to_string(k + 1) + ".vdb"},
                      {"final_atoms", atom_ids(plan.final_state, r.atoms.atom_count())},
                      {"deviation", deviation_json(d)},
@@ -262,16 +281,23 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
   for (std::size_t i = 0; i < shown; ++i) os << "  - " << r.verdict.violations[i].description << "\n";
   if (r.verdict.violations.size() > shown) os << "  ... and " << r.verdict.violations.size() - shown << " more in plan.json\n";
   if (!r.plans.empty()) {
-    os << "plans       " << r.plans.size() << " (A*: " << r.search.expanded << " states expanded";
+    os << "plans       " << r.plans.size() << " (A*: " << r.search.expanded << " states expanded in "
+       << fixed(r.search.seconds, 2) << " s";
     if (r.search.weight > 1)
-      os << "; the exact search hit its limit, so these come from weighted A* and cost at most " << r.search.weight
-         << "x the optimum";
+      os << "; the exact search hit its limit, so plans it did not prove come from weighted A* (w = "
+         << r.search.weight << ") with a proven gap against the lower bound " << fixed(r.search.lower_bound, 4);
     os << ")\n";
     for (std::size_t k = 0; k < r.plans.size(); ++k) {
       const Plan& plan = r.plans[k];
       const Deviation& d = r.deviations[k];
       os << "  " << (k + 1) << ". " << expression(r.problem, plan) << "  cost " << fixed(plan.cost, 4) << "\n";
       os << "     deviation: " << deviation_text(d, r.tolerance) << "\n";
+
+      os << "  " << (k + 1) << ". " << expression(r.problem, plan) << "  cost " << fixed(plan.cost, 4) << ", "
+         << optimality_text(plan, k) << "\n";
+      os << "     deviation: " << fixed(d.over_volume, 1) << " mm\u00B3 over, " << fixed(d.under_volume, 1)
+         << " mm\u00B3 under, worst " << fixed(d.worst_distance, 2) << " mm ("
+         << (d.within_tolerance ? "within" : "OUTSIDE") << " tolerance)\n";
       for (std::size_t s = 0; s < plan.steps.size(); ++s) {
         const PlanStep& st = plan.steps[s];
         const Primitive& p = r.primitives[std::size_t(st.primitive)];

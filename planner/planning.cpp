@@ -131,18 +131,14 @@ PlanningProblem symbolic_problem(const PlanningResult& r, const config::Planning
   return p;
 }
 
-void search_plans(int top_k, std::int64_t max_expansions, const Progress& progress, PlanningResult& r) {
+void search_plans(int top_k, const PlanningOptions& options, const Progress& progress, PlanningResult& r) {
   progress("search", 0);
-  SearchOptions search{top_k, max_expansions};
+  SearchOptions search{top_k, options.max_expansions};
+  // Plans that differ only in the order of one tool's consecutive actions in one setup
+  // are one plan to a shop: the search keeps the cheapest order of each such block.
+  search.block_orders = BlockOrders::Cheapest;
+  search.time_limit = options.search_time;
   r.plans = find_plans(r.problem, search, &r.search);
-  // When the exact search runs out of room before any plan, weighted A* still finds
-  // plans, with a proven bound on how far from the optimum they may be.
-  for (double w : {2.0, 5.0}) {
-    if (!r.plans.empty() || !r.search.limit_reached) break;
-    progress("search", 0.5);
-    search.weight = w;
-    r.plans = find_plans(r.problem, search, &r.search);
-  }
   progress("search", 1);
   if (r.plans.empty() && !r.verdict.decided_without_search) {
     r.verdict.manufacturable = false;
@@ -180,7 +176,7 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
   r.problem = symbolic_problem(r, defaults, options.max_uses);
   r.verdict = check_manufacturability(r.problem, r.measures, r.lattice);
   clock.lap("check");
-  if (r.verdict.manufacturable) search_plans(top_k, options.max_expansions, progress, r);
+  if (r.verdict.manufacturable) search_plans(top_k, options, progress, r);
   clock.lap("search");
   for (const Plan& plan : r.plans)
     r.deviations.push_back(measure_deviation(plan_outcome(r, plan), r.design, r.domain, r.tolerance));

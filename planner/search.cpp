@@ -1,7 +1,12 @@
 #include "planner/search.hpp"
 
+#include "planner/search_bound.hpp"
+
 #include <algorithm>
 #include <bit>
+#include <chrono>
+#include <set>
+#include <tuple>
 #include <cmath>
 #include <deque>
 #include <functional>
@@ -63,65 +68,13 @@ bool allowed(const PlanningProblem& p, int i, bool first, const std::vector<std:
   return !prim.raw_stock;                         // C4
 }
 
-// Per atom, the primitives that can deposit (or remove) it, cheapest first.
-struct Suppliers {
-  std::vector<std::vector<int>> additive, subtractive;
-};
-
-Suppliers suppliers_of(const PlanningProblem& p) {
-  Suppliers s;
-  s.additive.resize(p.atoms.size());
-  s.subtractive.resize(p.atoms.size());
-  for (int i = 0; i < int(p.primitives.size()); ++i) {
-    const PrimitiveSpec& prim = p.primitives[std::size_t(i)];
-    for (std::size_t a = 0; a < p.atoms.size(); ++a)
-      if (prim.atoms.test(int(a))) (prim.mode == Mode::Additive ? s.additive : s.subtractive)[a].push_back(i);
-  }
-  auto by_cost = [&](int x, int y) { return p.primitives[std::size_t(x)].cost_per_mm3 < p.primitives[std::size_t(y)].cost_per_mm3; };
-  for (auto& l : s.additive) std::sort(l.begin(), l.end(), by_cost);
-  for (auto& l : s.subtractive) std::sort(l.begin(), l.end(), by_cost);
-  return s;
-}
-
-double heuristic(const PlanningProblem& p, const Suppliers& sup, const AtomSet& state, const std::vector<std::uint8_t>& uses,
-                 bool first) {
-  double h = 0;
-  for (std::size_t a = 0; a < p.atoms.size(); ++a) {
-    const AtomSpec& atom = p.atoms[a];
-    const bool present = state.test(int(a));
-    if (atom.must_in && !present) {
-      // A later deposition may use any additive primitive still available after the
-      // first step, or (at the start) any additive one.
-      double best = kInfinity;
-      for (int i : sup.additive[a]) {
-        const PrimitiveSpec& prim = p.primitives[std::size_t(i)];
-        if (uses[std::size_t(i)] >= p.max_uses || (!first && prim.raw_stock)) continue;
-        best = prim.cost_per_mm3;
-        break;
-      }
-      if (best == kInfinity) return kInfinity;
-      h += best * atom.volume;
-    } else if (atom.must_out && present) {
-      double best = kInfinity;
-      for (int i : sup.subtractive[a]) {
-        if (uses[std::size_t(i)] >= p.max_uses) continue;
-        best = p.primitives[std::size_t(i)].cost_per_mm3;
-        break;
-      }
-      if (best == kInfinity) return kInfinity;
-      h += best * atom.volume;
-    }
-  }
-  return h / p.normaliser;
-}
-
 struct Node {
   int parent = -1;
   int primitive = -1;
-  int depth = 0;
   double g = 0;
   double step_volume = 0;
   double step_cost = 0;
+  bool bounded = false;  // h is the full bound, not the quick one
   AtomSet state;
   std::vector<std::uint8_t> uses;
 };
@@ -165,6 +118,156 @@ Plan plan_from(const std::deque<Node>& nodes, int leaf) {
   return plan;
 }
 
+std::vector<int> sequence_of(const Plan& plan) {
+  std::vector<int> s;
+  for (const PlanStep& step : plan.steps) s.push_back(step.primitive);
+  return s;
+}
+
+using Clock = std::chrono::steady_clock;
+
+// Whether `next` may follow `last` when one order per block is kept: within a block
+// (same mode, tool and setup) raw stock first, then by cost per mm^3, then by index.
+bool in_block_order(const PlanningProblem& p, int last, int next) {
+  if (last < 0) return true;
+  const PrimitiveSpec& a = p.primitives[std::size_t(last)];
+  const PrimitiveSpec& b = p.primitives[std::size_t(next)];
+  if (a.mode != b.mode || a.tool != b.tool || a.setup != b.setup) return true;
+  return std::make_tuple(!a.raw_stock, a.cost_per_mm3, last) < std::make_tuple(!b.raw_stock, b.cost_per_mm3, next);
+}
+
+// One best-first search (A*, or weighted A* for weight > 1) from the empty state.
+class Search {
+ public:
+  Search(const PlanningProblem& p, const SearchOptions& o, const LowerBound& bound, Clock::time_point deadline,
+         const std::set<std::vector<int>>& known, SearchStats& st)
+      : p_(p), o_(o), bound_(bound), deadline_(deadline), known_(known), st_(st) {}
+
+  // Accepted plans not in `known`, cheapest first (by f), at most `wanted`.
+  std::vector<Plan> run(int wanted);
+  // No plan the search did not return costs less than this (meaningful for weight 1).
+  double frontier() const { return frontier_; }
+  bool stopped_at_limit() const { return limit_; }
+
+ private:
+  struct Entry {
+    double f, g;
+    std::int64_t seq;
+    int node;
+  };
+  struct Worse {
+    bool operator()(const Entry& a, const Entry& b) const {
+      if (a.f != b.f) return a.f > b.f;
+      if (a.g != b.g) return a.g < b.g;  // prefer deeper on ties: reaches goals sooner
+      return a.seq > b.seq;
+    }
+  };
+  bool out_of_room() const;
+  void expand(int id);
+
+  const PlanningProblem& p_;
+  const SearchOptions& o_;
+  const LowerBound& bound_;
+  Clock::time_point deadline_;
+  const std::set<std::vector<int>>& known_;
+  SearchStats& st_;
+  std::deque<Node> nodes_;  // no reallocation: memory grows by blocks
+  std::priority_queue<Entry, std::vector<Entry>, Worse> open_;
+  std::int64_t seq_ = 0;
+  double frontier_ = kInfinity;
+  bool limit_ = false;
+};
+
+bool Search::out_of_room() const {
+  if (st_.expanded >= o_.max_expansions || std::int64_t(nodes_.size()) >= o_.max_states) return true;
+  // The clock is read every 256 expansions: cheap, and often enough.
+  return deadline_ != Clock::time_point::max() && (st_.expanded & 255) == 0 && Clock::now() >= deadline_;
+}
+
+void Search::expand(int id) {
+  const int n = int(p_.primitives.size());
+  const int last = nodes_[std::size_t(id)].primitive;
+  for (int i = 0; i < n; ++i) {
+    if (!allowed(p_, i, id == 0, nodes_[std::size_t(id)].uses)) continue;
+    if (o_.block_orders == BlockOrders::Cheapest && !in_block_order(p_, last, i)) continue;
+    AtomSet next;
+    double volume = 0;
+    if (!apply(p_, nodes_[std::size_t(id)].state, i, next, volume)) continue;
+    Node child;
+    child.parent = id;
+    child.primitive = i;
+    child.step_volume = volume;
+    child.step_cost = (p_.primitives[std::size_t(i)].cost_per_mm3 * volume + fixed_cost(p_, last, i)) / p_.normaliser;
+    child.g = nodes_[std::size_t(id)].g + child.step_cost;
+    child.state = std::move(next);
+    child.uses = nodes_[std::size_t(id)].uses;
+    ++child.uses[std::size_t(i)];
+    // The quick bound orders the child for now; the full one is computed when it comes
+    // up (most children never do).
+    const double h = bound_.quick(child.state, child.uses, i);
+    if (h == kInfinity) continue;
+    ++st_.generated;
+    nodes_.push_back(std::move(child));
+    open_.push({nodes_.back().g + o_.weight * h, nodes_.back().g, seq_++, int(nodes_.size()) - 1});
+  }
+}
+
+std::vector<Plan> Search::run(int wanted) {
+  std::vector<Plan> plans;
+  const int n = int(p_.primitives.size());
+  nodes_.push_back({-1, -1, 0, 0, 0, true, AtomSet(int(p_.atoms.size())), std::vector<std::uint8_t>(std::size_t(n), 0)});
+  const double h0 = bound_(nodes_[0].state, nodes_[0].uses, -1);
+  if (h0 == kInfinity) {
+    frontier_ = kInfinity;
+    return plans;
+  }
+  open_.push({o_.weight * h0, 0, seq_++, 0});
+  std::unordered_map<std::vector<std::uint64_t>, int, KeyHash> pops;
+  const std::int64_t rejected_before = st_.rejected;
+  while (!open_.empty() && int(plans.size()) < wanted) {
+    const Entry e = open_.top();
+    Node& node = nodes_[std::size_t(e.node)];
+    if (!node.bounded) {
+      node.bounded = true;
+      const double h = bound_(node.state, node.uses, node.primitive);
+      open_.pop();
+      if (h == kInfinity) continue;
+      open_.push({node.g + o_.weight * h, node.g, e.seq, e.node});
+      continue;
+    }
+    if (e.node != 0) {
+      int& count = pops[key_of(node)];
+      // k cheapest arrivals at this key suffice, plus one for each plan turned down.
+      if (count >= o_.top_k + (st_.rejected - rejected_before)) {
+        open_.pop();
+        continue;
+      }
+      ++count;
+    }
+    if (e.node != 0 && is_goal(p_, node.state)) {
+      open_.pop();
+      Plan plan = plan_from(nodes_, e.node);
+      if (known_.count(sequence_of(plan))) continue;
+      if (!o_.accept || o_.accept(plan)) {
+        plans.push_back(std::move(plan));
+      } else if (++st_.rejected >= o_.max_rejected) {
+        limit_ = true;
+        break;
+      }
+      continue;
+    }
+    if (out_of_room()) {
+      limit_ = true;
+      break;
+    }
+    open_.pop();
+    ++st_.expanded;
+    expand(e.node);
+  }
+  frontier_ = open_.empty() ? kInfinity : open_.top().f;
+  return plans;
+}
+
 }  // namespace
 
 bool is_goal(const PlanningProblem& p, const AtomSet& state) {
@@ -176,89 +279,75 @@ bool is_goal(const PlanningProblem& p, const AtomSet& state) {
   return true;
 }
 
+namespace {
+
+// Plans from weighted A* at growing weights until `want` plans are known, each new one
+// not among `known`.
+void fill_with_weighted(const PlanningProblem& p, const SearchOptions& options, const LowerBound& bound,
+                        Clock::time_point start, std::vector<Plan>& plans, SearchStats& st) {
+  const double weights[] = {2.0, 5.0, 50.0};
+  for (std::size_t k = 0; k < std::size(weights) && int(plans.size()) < options.top_k; ++k) {
+    if (st.rejected >= options.max_rejected) break;
+    Clock::time_point deadline = Clock::time_point::max();
+    if (options.time_limit > 0) {
+      const auto end = start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(options.time_limit));
+      const auto now = Clock::now();
+      if (now >= end) break;
+      // Half of what is left, all of it for the last weight.
+      deadline = k + 1 == std::size(weights) ? end : now + (end - now) / 2;
+    }
+    std::set<std::vector<int>> known;
+    for (const Plan& plan : plans) known.insert(sequence_of(plan));
+    SearchOptions weighted = options;
+    weighted.weight = weights[k];
+    SearchStats local;
+    local.rejected = st.rejected;
+    Search search(p, weighted, bound, deadline, known, local);
+    std::vector<Plan> found = search.run(options.top_k - int(plans.size()));
+    st.expanded += local.expanded;
+    st.generated += local.generated;
+    st.rejected = local.rejected;
+    if (!found.empty()) st.weight = weights[k];
+    for (Plan& plan : found) {
+      plan.exact = false;
+      plans.push_back(std::move(plan));
+    }
+  }
+}
+
+}  // namespace
+
 std::vector<Plan> find_plans(const PlanningProblem& p, const SearchOptions& options, SearchStats* stats) {
   SearchStats local;
   SearchStats& st = stats ? *stats : local;
   st = {};
-  std::vector<Plan> plans;
-  const Suppliers sup = suppliers_of(p);
-  const int n = int(p.primitives.size());
-
-  std::deque<Node> nodes;  // no reallocation: memory grows by blocks
-  nodes.push_back({-1, -1, 0, 0, 0, 0, AtomSet(int(p.atoms.size())), std::vector<std::uint8_t>(std::size_t(n), 0)});
-  struct Entry {
-    double f, g;
-    std::int64_t seq;
-    int node;
-  };
-  auto worse = [](const Entry& a, const Entry& b) {
-    if (a.f != b.f) return a.f > b.f;
-    if (a.g != b.g) return a.g < b.g;  // prefer deeper on ties: reaches goals sooner
-    return a.seq > b.seq;
-  };
-  std::priority_queue<Entry, std::vector<Entry>, decltype(worse)> open(worse);
-  std::int64_t seq = 0;
-  const double h0 = heuristic(p, sup, nodes[0].state, nodes[0].uses, true);
-  if (h0 == kInfinity) {
-    st.exhausted = true;
-    return plans;
-  }
+  const Clock::time_point start = Clock::now();
+  const LowerBound bound(p);
+  const std::set<std::vector<int>> none;
+  Clock::time_point deadline = Clock::time_point::max();
+  if (options.time_limit > 0)
+    deadline = start + std::chrono::duration_cast<Clock::duration>(
+                           std::chrono::duration<double>(options.time_limit * (options.weight > 1 ? 1.0 : 0.5)));
+  Search exact(p, options, bound, deadline, none, st);
+  std::vector<Plan> plans = exact.run(options.top_k);
   st.weight = options.weight;
-  open.push({options.weight * h0, 0, seq++, 0});
-  std::unordered_map<std::vector<std::uint64_t>, int, KeyHash> pops;
-
-  while (!open.empty() && int(plans.size()) < options.top_k) {
-    const Entry e = open.top();
-    open.pop();
-    const int id = e.node;
-    if (id != 0) {
-      int& count = pops[key_of(nodes[std::size_t(id)])];
-      // k cheapest arrivals at this key suffice, plus one for each plan turned down.
-      if (count >= options.top_k + st.rejected) continue;
-      ++count;
-    }
-    if (id != 0 && is_goal(p, nodes[std::size_t(id)].state)) {
-      Plan plan = plan_from(nodes, id);
-      if (!options.accept || options.accept(plan)) {
-        plans.push_back(std::move(plan));
-      } else if (++st.rejected >= options.max_rejected) {
-        st.limit_reached = true;
-        break;
-      }
-      continue;
-    }
-    if (st.expanded >= options.max_expansions || std::int64_t(nodes.size()) >= options.max_states) {
-      st.limit_reached = true;
-      break;
-    }
-    ++st.expanded;
-    const bool first = id == 0;
-    for (int i = 0; i < n; ++i) {
-      if (!allowed(p, i, first, nodes[std::size_t(id)].uses)) continue;
-      AtomSet next;
-      double volume = 0;
-      if (!apply(p, nodes[std::size_t(id)].state, i, next, volume)) continue;
-      Node child;
-      child.parent = id;
-      child.primitive = i;
-      child.depth = nodes[std::size_t(id)].depth + 1;
-      child.step_volume = volume;
-      child.step_cost =
-          (p.primitives[std::size_t(i)].cost_per_mm3 * volume + fixed_cost(p, nodes[std::size_t(id)].primitive, i)) /
-          p.normaliser;
-      child.g = nodes[std::size_t(id)].g + child.step_cost;
-      child.state = std::move(next);
-      child.uses = nodes[std::size_t(id)].uses;
-      ++child.uses[std::size_t(i)];
-      const double h = heuristic(p, sup, child.state, child.uses, false);
-      if (h == kInfinity) continue;
-      ++st.generated;
-      nodes.push_back(std::move(child));
-      const int child_id = int(nodes.size()) - 1;
-      open.push({nodes.back().g + options.weight * h, nodes.back().g, seq++, child_id});
-    }
+  st.limit_reached = exact.stopped_at_limit();
+  if (options.weight > 1) {
+    for (Plan& plan : plans) plan.exact = false;
+  } else if (int(plans.size()) < options.top_k && !exact.stopped_at_limit()) {
+    st.exhausted = true;
+  } else if (int(plans.size()) < options.top_k) {
+    fill_with_weighted(p, options, bound, start, plans, st);
   }
-  if (open.empty() && int(plans.size()) < options.top_k) st.exhausted = true;
+  // Gaps against the best proven lower bound on the cheapest accepted plan.
+  const bool first_exact = !plans.empty() && plans.front().exact;
+  st.lower_bound = first_exact ? plans.front().cost : std::min(exact.frontier(), plans.empty() ? kInfinity : plans.front().cost);
+  if (options.weight > 1) st.lower_bound = std::max(0.0, plans.empty() ? 0.0 : plans.front().cost / options.weight);
+  if (st.lower_bound == kInfinity) st.lower_bound = 0;
+  std::stable_sort(plans.begin(), plans.end(), [](const Plan& a, const Plan& b) { return a.cost < b.cost; });
+  for (Plan& plan : plans)
+    plan.gap = st.lower_bound > 0 ? std::max(0.0, plan.cost / st.lower_bound - 1) : (plan.cost > 0 ? kInfinity : 0.0);
+  st.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return plans;
 }
 

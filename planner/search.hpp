@@ -58,16 +58,33 @@ struct Plan {
   std::vector<PlanStep> steps;
   double cost = 0;  // normalised total
   AtomSet final_state;
+  // Proven: cost <= (1 + gap) x the cheapest accepted plan's cost. 0 for a plan proven
+  // optimal; for the k-th of k plans found in cost order by the exact search, how much
+  // dearer it is than the first.
+  double gap = 0;
+  bool exact = true;  // proven to be the rank-th cheapest accepted plan
 };
 
 struct SearchStats {
   std::int64_t expanded = 0;
   std::int64_t generated = 0;
   bool exhausted = false;  // the search space ran out before k plans were found
-  bool limit_reached = false;
-  double weight = 1.0;  // of the search that produced the plans (1: proven optimal)
+  bool limit_reached = false;  // the exact search stopped at a limit before k plans
+  double weight = 1.0;  // of the last search that produced plans (1: exact A*)
   std::int64_t rejected = 0;  // goal plans `SearchOptions::accept` turned down
+  // Proven lower bound on the cheapest accepted plan's cost (normalised): its cost when
+  // the exact search found it, else the least f = g + h left on the exact search's open
+  // list when it stopped (no plan it did not reach can cost less).
+  double lower_bound = 0;
+  double seconds = 0;  // wall time of the whole search
 };
+
+// Which orders of consecutive actions of one block (same mode, tool and setup) the search
+// tells apart. Within a block the fixed costs do not depend on the order, and the
+// cheapest order is by cost per mm^3 (each atom is paid at the rate of the first action
+// that changes it), so keeping only that order loses no optimum; plans that differ only
+// in such an order are then not listed as different plans.
+enum class BlockOrders { Every, Cheapest };
 
 struct SearchOptions {
   int top_k = 5;
@@ -85,12 +102,20 @@ struct SearchOptions {
   // `max_rejected` plans are turned down before the search stops with limit_reached.
   std::function<bool(const Plan&)> accept;
   std::int64_t max_rejected = 50;
+  BlockOrders block_orders = BlockOrders::Every;
+  // Wall-clock budget of the whole search in seconds (0: none). When the exact search has
+  // not finished in half of it, weighted A* finds plans in the rest, each with its proven
+  // gap. A budget makes the result depend on the machine's speed; the expansion and state
+  // limits do not.
+  double time_limit = 0;
 };
 
-// The k cheapest distinct plans, cheapest first, by A* with an admissible and
-// consistent heuristic (every missing must-in atom must still be deposited by an
-// additive primitive containing it, every present must-out atom removed by a
-// subtractive one, each at that primitive's cost per mm^3 at least).
+// The k cheapest distinct accepted plans, cheapest first, by A* with the admissible and
+// consistent bound of planner/search_bound.hpp. When the exact search stops at a limit
+// (expansions, states, half the time budget) before k plans, weighted A* (w = 2, then 5,
+// then 50) fills the list with plans not yet found, cheapest first, each with its proven
+// gap against the exact search's lower bound (Plan::gap, Plan::exact,
+// SearchStats::lower_bound). With options.weight > 1 only that weighted search runs.
 std::vector<Plan> find_plans(const PlanningProblem& problem, const SearchOptions& options = {},
                              SearchStats* stats = nullptr);
 

@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <random>
 #include <set>
+#include <tuple>
 
+#include "planner/search_bound.hpp"
 #include "planner_fixtures.hpp"
 
 namespace hybridctl::planner {
@@ -75,7 +77,7 @@ TEST(PaperExample, FindsE1E2TheirP1P2SwapsAndE3ButNeverE4) {
 TEST(PaperExample, PlansTheAcceptHookTurnsDownAreSkippedAndTheNextCheapestTakeTheirPlace) {
   const VoxelProblem vp = paper_example(false);
   const auto all = find_plans(vp.problem, {6});
-  ASSERT_EQ(all.size(), 6u);
+  ASSERT_EQ(all.size(), enumerate_plans(vp.problem).size());  // the five there are
   // Turn down every plan whose first step is P1: the search must go on past them and
   // return the cheapest plans that do not start with P1, in cost order.
   SearchOptions options{3};
@@ -216,6 +218,206 @@ TEST(Search, ReuseUpToKTimesAgreesWithTheOracleToo) {
     }
   }
   EXPECT_GT(reused, 0);  // reuse really occurs in these plans
+}
+
+// Whether a plan keeps the cheapest order of each block (consecutive actions with the
+// same mode, tool and setup): raw stock first, then by cost per mm^3, then by index.
+bool in_block_order(const PlanningProblem& p, const Plan& plan) {
+  for (std::size_t s = 1; s < plan.steps.size(); ++s) {
+    const int i = plan.steps[s - 1].primitive, j = plan.steps[s].primitive;
+    const PrimitiveSpec& a = p.primitives[std::size_t(i)];
+    const PrimitiveSpec& b = p.primitives[std::size_t(j)];
+    if (a.mode != b.mode || a.tool != b.tool || a.setup != b.setup) continue;
+    if (std::make_tuple(!a.raw_stock, a.cost_per_mm3, i) > std::make_tuple(!b.raw_stock, b.cost_per_mm3, j)) return false;
+  }
+  return true;
+}
+
+TEST(Search, OneOrderPerBlockFindsTheOptimumAndTheCheapestPlansInBlockOrder) {
+  std::mt19937 rng(2026);
+  int compared = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const int n = 2 + trial % 7;  // 2..8 primitives
+    VoxelProblem vp = random_instance(rng, n);
+    vp.problem.fixed = {trial % 3 == 0 ? 5.0 : 0.0, trial % 5 == 0 ? 3.0 : 0.0, trial % 4 == 0 ? 7.0 : 0.0};
+    for (auto& p : vp.problem.primitives) {
+      p.tool = "T" + std::to_string(rng() % 2);
+      p.setup = rng() % 3 == 0 ? "side" : "top";
+    }
+    const auto oracle = enumerate_plans(vp.problem);
+    std::vector<Plan> ordered;
+    for (const Plan& p : oracle)
+      if (in_block_order(vp.problem, p)) ordered.push_back(p);
+    SearchOptions options{5};
+    options.block_orders = BlockOrders::Cheapest;
+    SearchStats stats;
+    const auto found = find_plans(vp.problem, options, &stats);
+    ASSERT_EQ(found.size(), std::min<std::size_t>(5, ordered.size())) << "trial " << trial;
+    if (!oracle.empty()) {
+      // Keeping one order per block loses no optimum.
+      ASSERT_FALSE(found.empty());
+      EXPECT_NEAR(found.front().cost, oracle.front().cost, 1e-9 * std::max(1.0, oracle.front().cost)) << "trial " << trial;
+      EXPECT_NEAR(stats.lower_bound, oracle.front().cost, 1e-9 * std::max(1.0, oracle.front().cost));
+      ++compared;
+    }
+    for (std::size_t i = 0; i < found.size(); ++i) {
+      EXPECT_TRUE(in_block_order(vp.problem, found[i]));
+      EXPECT_TRUE(found[i].exact);
+      EXPECT_NEAR(found[i].cost, ordered[i].cost, 1e-9 * std::max(1.0, ordered[i].cost)) << "trial " << trial;
+      EXPECT_EQ(testing::evaluate(vp, found[i]), testing::atoms_union(vp, found[i].final_state)) << "trial " << trial;
+    }
+  }
+  EXPECT_GT(compared, 150);
+}
+
+// Two removals with one tool: the cheaper must go first, since the atoms both hold are
+// paid at the rate of whichever comes first. One order per block keeps that one.
+TEST(Search, ARemovalWhoseCostDependsOnTheOrderIsCostedInItsCheapestOrder) {
+  // Atoms: 0 core (must-in), 1 in both removals, 2 only in the dear one, 3 only in the
+  // cheap one (all must-out); the stock holds them all.
+  PlanningProblem p;
+  p.atoms = {{10, true, false}, {8, false, true}, {1, false, true}, {1, false, true}};
+  auto prim = [&](std::string name, Mode mode, double cost, std::initializer_list<int> atoms, bool raw = false) {
+    PrimitiveSpec s{std::move(name), mode, raw, cost, AtomSet(4), "T1", "top"};
+    for (int a : atoms) s.atoms.set(a);
+    if (raw) s.tool = "stock";
+    return s;
+  };
+  p.primitives = {prim("Dear", Mode::Subtractive, 3.0, {1, 2}), prim("Cheap", Mode::Subtractive, 1.0, {1, 3}),
+                  prim("Stock", Mode::Additive, 0.0, {0, 1, 2, 3}, true)};
+  for (BlockOrders orders : {BlockOrders::Every, BlockOrders::Cheapest}) {
+    SearchOptions options{1};
+    options.block_orders = orders;
+    const auto plans = find_plans(p, options);
+    ASSERT_EQ(plans.size(), 1u);
+    EXPECT_EQ(expression(p, plans[0]), "((Stock \u2212 Cheap) \u2212 Dear)");
+    EXPECT_DOUBLE_EQ(plans[0].cost, 1.0 * 9 + 3.0 * 1 + 5.0 * 0);  // stock costs nothing
+    EXPECT_DOUBLE_EQ(plans[0].cost, enumerate_plans(p, 1).front().cost);
+  }
+}
+
+// A primitive that changes no must-in or must-out atom can still pay: a cheap roughing
+// pass over atoms free either way leaves less to the dear tool that must follow.
+TEST(Search, APrimitiveThatTouchesOnlyFreeAtomsIsKeptWhenItLowersTheCost) {
+  PlanningProblem p;
+  p.atoms = {{10, true, false}, {20, false, false}, {2, false, true}};  // core, free band, must-out
+  PrimitiveSpec stock{"Stock", Mode::Additive, true, 0.0, AtomSet(3), "stock", ""};
+  PrimitiveSpec rough{"Rough", Mode::Subtractive, false, 0.1, AtomSet(3), "T1", "top"};
+  PrimitiveSpec finish{"Finish", Mode::Subtractive, false, 2.0, AtomSet(3), "T2", "top"};
+  for (int a : {0, 1, 2}) stock.atoms.set(a);
+  rough.atoms.set(1);
+  finish.atoms.set(1);
+  finish.atoms.set(2);
+  p.primitives = {stock, rough, finish};
+  p.fixed = {1.0, 20.0, 40.0};
+  const auto plans = find_plans(p, {1});
+  ASSERT_EQ(plans.size(), 1u);
+  EXPECT_EQ(expression(p, plans[0]), "((Stock \u2212 Rough) \u2212 Finish)");
+  EXPECT_DOUBLE_EQ(plans[0].cost, enumerate_plans(p, 1).front().cost);
+}
+
+// A fixed cost that changes the best order: three removals, two with tool T1. By rate
+// alone the order is A (T1), B (T2), C (T1), with two tool changes; keeping T1's actions
+// together saves one change and costs more in volume only when the change is cheap.
+TEST(Search, AToolChangeCostThatChangesTheBestOrderIsHonoured) {
+  for (double tool_change : {0.0, 50.0}) {
+    PlanningProblem p;
+    p.atoms = {{10, true, false}, {4, false, true}, {4, false, true}, {4, false, true}, {1, false, true}};
+    PrimitiveSpec stock{"Stock", Mode::Additive, true, 0.0, AtomSet(5), "stock", ""};
+    for (int a = 0; a < 5; ++a) stock.atoms.set(a);
+    PrimitiveSpec a{"A", Mode::Subtractive, false, 1.0, AtomSet(5), "T1", "top"};
+    PrimitiveSpec b{"B", Mode::Subtractive, false, 2.0, AtomSet(5), "T2", "top"};
+    PrimitiveSpec c{"C", Mode::Subtractive, false, 3.0, AtomSet(5), "T1", "top"};
+    a.atoms.set(1);
+    b.atoms.set(2), b.atoms.set(4);
+    c.atoms.set(3), c.atoms.set(4);
+    p.primitives = {stock, a, b, c};
+    p.fixed = {tool_change, 0, 0};
+    for (BlockOrders orders : {BlockOrders::Every, BlockOrders::Cheapest}) {
+      SearchOptions options{1};
+      options.block_orders = orders;
+      const auto plans = find_plans(p, options);
+      ASSERT_EQ(plans.size(), 1u);
+      EXPECT_DOUBLE_EQ(plans[0].cost, enumerate_plans(p, 1).front().cost) << tool_change;
+      // With a dear tool change T1's two removals are neighbours.
+      const std::string e = expression(p, plans[0]);
+      if (tool_change > 0) {
+        EXPECT_TRUE(e.find("A) \u2212 C)") != std::string::npos || e.find("C) \u2212 A)") != std::string::npos) << e;
+      }
+    }
+  }
+}
+
+// The lower bound is admissible and consistent: along every plan the enumerator finds,
+// it never exceeds what the rest of the plan costs, nor falls by more than a step costs.
+TEST(Search, TheLowerBoundNeverOverestimatesAndFallsByAtMostAStepsCost) {
+  std::mt19937 rng(16);
+  int checked = 0;
+  for (int trial = 0; trial < 80; ++trial) {
+    VoxelProblem vp = random_instance(rng, 2 + trial % 5);
+    // With a tolerance band there are free atoms, whose side effects the bound counts.
+    vp = make_problem(vp.primitives, vp.design, vp.domain, trial % 2 ? 1.0 : 0.0);
+    vp.problem.fixed = {trial % 3 ? 5.0 : 0.0, trial % 4 ? 3.0 : 0.0, trial % 5 ? 7.0 : 0.0};
+    for (auto& p : vp.problem.primitives) {
+      p.tool = "T" + std::to_string(rng() % 3);
+      p.setup = rng() % 2 ? "side" : "top";
+    }
+    const LowerBound bound(vp.problem);
+    for (const Plan& plan : enumerate_plans(vp.problem, 200)) {
+      AtomSet state(int(vp.problem.atoms.size()));
+      std::vector<std::uint8_t> uses(vp.problem.primitives.size(), 0);
+      double rest = plan.cost, h = bound(state, uses, -1);
+      for (const PlanStep& step : plan.steps) {
+        EXPECT_LE(h, rest + 1e-9) << "trial " << trial;
+        const PrimitiveSpec& prim = vp.problem.primitives[std::size_t(step.primitive)];
+        for (std::size_t w = 0; w < state.words().size(); ++w)
+          state.words()[w] = prim.mode == Mode::Additive ? state.words()[w] | prim.atoms.words()[w]
+                                                         : state.words()[w] & ~prim.atoms.words()[w];
+        ++uses[std::size_t(step.primitive)];
+        const double next = bound(state, uses, step.primitive);
+        EXPECT_LE(h, step.cost + next + 1e-9) << "trial " << trial << ": the bound fell by more than a step";
+        EXPECT_LE(bound.quick(state, uses, step.primitive), next + 1e-12);
+        h = next;
+        rest -= step.cost;
+        ++checked;
+      }
+      EXPECT_NEAR(h, 0, 1e-12);  // nothing is owed at the goal
+    }
+  }
+  EXPECT_GT(checked, 1000);
+}
+
+// Stopped early, the search still answers: plans from weighted A*, each with a gap that
+// holds against the true optimum, and a lower bound that does not exceed it.
+TEST(Search, StoppedEarlyItReturnsPlansWithAProvenGap) {
+  std::mt19937 rng(404);
+  int inexact = 0;
+  for (int trial = 0; trial < 120; ++trial) {
+    VoxelProblem vp = random_instance(rng, 5 + trial % 4);
+    vp.problem.fixed = {2.0, 0, 4.0};
+    const auto oracle = enumerate_plans(vp.problem, 1);
+    if (oracle.empty()) continue;
+    const double optimum = oracle.front().cost;
+    for (std::int64_t limit : {3, 5, 8}) {  // expansions: rarely enough to prove anything
+      SearchOptions options{3, limit};
+      SearchStats stats;
+      const auto found = find_plans(vp.problem, options, &stats);
+      if (found.empty()) {
+        EXPECT_TRUE(stats.limit_reached) << "trial " << trial;
+        continue;
+      }
+      EXPECT_LE(stats.lower_bound, optimum + 1e-9) << "trial " << trial;
+      for (std::size_t i = 0; i < found.size(); ++i) {
+        EXPECT_TRUE(is_goal(vp.problem, found[i].final_state));
+        EXPECT_LE(found[i].cost, (1 + found[i].gap) * optimum + 1e-9) << "trial " << trial;
+        EXPECT_GE(found[i].cost, optimum - 1e-9);
+        if (i > 0) EXPECT_LE(found[i - 1].cost, found[i].cost);
+        if (i == 0 && found[i].exact) EXPECT_NEAR(found[i].cost, optimum, 1e-9 * std::max(1.0, optimum));
+        inexact += !found[i].exact;
+      }
+    }
+  }
+  EXPECT_GT(inexact, 10);  // the limit really cut the exact search short
 }
 
 TEST(Search, AnUnreachableDesignYieldsNoPlan) {

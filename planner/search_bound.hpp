@@ -1,0 +1,55 @@
+#pragma once
+// The admissible lower bound of the plan search: what any completion of a partial plan
+// must still pay, from its state, the primitives it may still use and its last action.
+// Three parts, on disjoint shares of the cost so that they add:
+//  - atoms: a missing must-in atom is deposited at least once, a present must-out atom
+//    removed at least once, each at the cheapest rate of a primitive still allowed that
+//    holds it (the classic bound);
+//  - side effects: the primitive that deposits the dearest missing must-in atom also
+//    deposits its absent other atoms (and any must-out one among them must then be
+//    removed); likewise the removal of a must-out atom takes present other atoms with it
+//    (a must-in one must come back);
+//  - fixed costs: a mode switch when the other mode is still needed (two when every
+//    additive primitive left holds a must-out atom and the plan is removing now), a tool
+//    change per tool that some atom can only be changed by, other than the current one,
+//    and likewise per setup.
+// The bound is consistent (it never falls by more than an action costs), which the
+// search's duplicate detection relies on; tests/planner/search_bound_test.cpp checks both
+// properties against the exhaustive enumerator.
+
+#include <cstdint>
+#include <vector>
+
+#include "planner/search.hpp"
+
+namespace hybridctl::planner {
+
+class LowerBound {
+ public:
+  explicit LowerBound(const PlanningProblem& problem);
+
+  // The bound in normalised cost units, +infinity when the goal is out of reach (a
+  // must-in atom no allowed primitive deposits, a must-out atom none removes).
+  // `uses[i]`: how often primitive i has been used; `last`: the previous action, -1 at
+  // the start (then raw stocks are allowed and the first action has no fixed cost).
+  double operator()(const AtomSet& state, const std::vector<std::uint8_t>& uses, int last) const;
+
+  // Only the atom part and the fixed costs: cheaper, never above operator().
+  double quick(const AtomSet& state, const std::vector<std::uint8_t>& uses, int last) const;
+
+ private:
+  struct Rates;
+  Rates rates(const std::vector<std::uint8_t>& uses, bool first) const;
+  double atom_part(const AtomSet& state, const Rates& r) const;
+  double side_effects(const AtomSet& state, const Rates& r) const;
+  double fixed_part(const AtomSet& state, const std::vector<std::uint8_t>& uses, int last) const;
+
+  const PlanningProblem& p_;
+  int atoms_ = 0;
+  std::vector<std::uint64_t> must_in_, must_out_;  // masks
+  std::vector<std::vector<int>> adders_, removers_;  // per atom, cheapest first
+  std::vector<int> tool_id_, setup_id_;               // per primitive
+  std::vector<bool> dirty_;  // an additive primitive holding a must-out atom
+};
+
+}  // namespace hybridctl::planner
