@@ -14,22 +14,6 @@ namespace hybridctl::geometry {
 
 using namespace detail;
 
-namespace {
-
-bool is_finite_extent(const IndexBox& e) {
-  return e.lo.x > -kUnboundedExtent && e.lo.y > -kUnboundedExtent && e.lo.z > -kUnboundedExtent &&
-         e.hi.x < kUnboundedExtent && e.hi.y < kUnboundedExtent && e.hi.z < kUnboundedExtent;
-}
-
-IndexBox grow(const IndexBox& b, const IndexBox& ext) {
-  return {{int(clamp_extent(std::int64_t(b.lo.x) + ext.lo.x)), int(clamp_extent(std::int64_t(b.lo.y) + ext.lo.y)),
-           int(clamp_extent(std::int64_t(b.lo.z) + ext.lo.z))},
-          {int(clamp_extent(std::int64_t(b.hi.x) + ext.hi.x - 1)), int(clamp_extent(std::int64_t(b.hi.y) + ext.hi.y - 1)),
-           int(clamp_extent(std::int64_t(b.hi.z) + ext.hi.z - 1))}};
-}
-
-}  // namespace
-
 double AxialSection::radius_squared_at(double z) const {
   if (z < from - kLengthSlack * std::max(1.0, std::abs(from)) || z > to + kLengthSlack * std::max(1.0, std::abs(to)))
     return -1;

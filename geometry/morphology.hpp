@@ -10,6 +10,7 @@
 // FFT convolution and the brute-force sum compute it for any offset set and serve as
 // oracles in the tests.
 
+#include <functional>
 #include <limits>
 #include <variant>
 #include <vector>
@@ -98,6 +99,23 @@ Solid dilate(const Solid& solid, const StructuringElement& element, const IndexB
 // along the same axis share one distance transform across it (a cutter, its shank and
 // holder, and every other tool from the same side).
 std::vector<Solid> dilate_each(const Solid& solid, const std::vector<StructuringElement>& elements, const IndexBox& domain);
+// Where an axial tool sweeps without its clearance meeting the solid: the voxels of
+// `domain` that the cutting part B covers at some position p (its tip) where none of the
+// clearance bodies, placed at p, meets the solid:
+//   (complement of U_i (solid (+) -C_i)) (+) B,   within `domain`.
+// No clearance bodies: the tip itself must lie outside the solid (C = {0}). Every body of
+// a sweep shares the cutting part's axis and direction.
+struct ToolSweep {
+  AxialBody cutting;
+  std::vector<AxialBody> clearance;
+};
+// Exact, voxel for voxel. When the clearance's union never narrows away from the tip and
+// never ends (a cutter in its holder), the free tip positions in every column along the
+// axis are one ray, so sweeps along one axis share one distance transform across it and
+// the rest is work on heightmaps (morphology_columns.cpp); other clearances take the
+// dilations above. Sweeps along the same axis share the work. `done(i)` reports sweep i.
+std::vector<Solid> tool_sweeps(const Solid& solid, const std::vector<ToolSweep>& sweeps, const IndexBox& domain,
+                               const std::function<void(std::size_t)>& done = {});
 // Erosion S (-) B = { p : p + B inside S }, computed as the complement of the dilation
 // of the complement by -B.
 Solid erode(const Solid& solid, const StructuringElement& element, MorphologyMethod method = MorphologyMethod::Auto);

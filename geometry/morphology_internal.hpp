@@ -5,6 +5,7 @@
 //   morphology_axial.cpp     axial bodies: distances across the axis, then column sweeps along it
 //   morphology_shifts.cpp    the union of shifted copies, 64 voxels a word; the brute-force sum
 //   morphology_fft.cpp       convolution of indicator functions with FFTW
+//   morphology_columns.cpp   tool sweeps: free tip positions per column, heightmaps
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -28,6 +29,20 @@ inline int& component(Index3& v, Axis a) { return a == Axis::X ? v.x : a == Axis
 
 inline std::int64_t clamp_extent(std::int64_t v) {
   return std::clamp<std::int64_t>(v, -kUnboundedExtent, kUnboundedExtent);
+}
+
+inline bool is_finite_extent(const IndexBox& e) {
+  return e.lo.x > -kUnboundedExtent && e.lo.y > -kUnboundedExtent && e.lo.z > -kUnboundedExtent &&
+         e.hi.x < kUnboundedExtent && e.hi.y < kUnboundedExtent && e.hi.z < kUnboundedExtent;
+}
+
+// The box `b` grown by an element's extent `ext` (half-open, as element_extent gives it):
+// every voxel of b plus every offset of the element.
+inline IndexBox grow(const IndexBox& b, const IndexBox& ext) {
+  return {{int(clamp_extent(std::int64_t(b.lo.x) + ext.lo.x)), int(clamp_extent(std::int64_t(b.lo.y) + ext.lo.y)),
+           int(clamp_extent(std::int64_t(b.lo.z) + ext.lo.z))},
+          {int(clamp_extent(std::int64_t(b.hi.x) + ext.hi.x - 1)), int(clamp_extent(std::int64_t(b.hi.y) + ext.hi.y - 1)),
+           int(clamp_extent(std::int64_t(b.hi.z) + ext.hi.z - 1))}};
 }
 
 // Large scratch buffers are kept for the next call: on these machines first-touch page

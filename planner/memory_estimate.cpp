@@ -41,6 +41,12 @@ Box3 planning_region(const config::Machine& m, const Box3& design, double tolera
   return region;
 }
 
+geometry::IndexBox planning_domain(const config::Machine& m, const geometry::Lattice& lattice, const Box3& design,
+                                   double tolerance) {
+  const geometry::IndexBox region = lattice.centers_within(planning_region(m, design, tolerance));
+  return {{region.lo.x - 2, region.lo.y - 2, region.lo.z - 2}, {region.hi.x + 2, region.hi.y + 2, region.hi.z + 2}};
+}
+
 double planning_memory_bytes(const Box3& part_bounds, const config::Machine& m, double h, double tolerance) {
   const Box3 region = planning_region(m, part_bounds, tolerance);
   const double voxels = geometry::grid_voxels(region, h, 2);

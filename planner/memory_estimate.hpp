@@ -13,6 +13,10 @@ namespace hybridctl::planner {
 // The region planning looks at: the design with room for overfill and the tolerance
 // band, and every raw stock.
 geometry::Box3 planning_region(const config::Machine& machine, const geometry::Box3& design, double tolerance);
+// The voxels of the planning region on `lattice`, with 2 to spare on every side: the
+// domain every primitive, atom and plan state lives in.
+geometry::IndexBox planning_domain(const config::Machine& machine, const geometry::Lattice& lattice,
+                                   const geometry::Box3& design, double tolerance);
 
 // Bytes planning takes at voxel size h: the atom labels (4 bytes a domain voxel) and the
 // dense solids alive at once (design, tolerance zone, one per primitive, plan outcomes).

@@ -66,8 +66,7 @@ void voxelize_design(const geometry::TriangleMesh& part, const std::string& part
   r.design_volume = r.design.volume();
   const Box3 bb = r.design.bounding_box_mm();
   r.bounding_box_volume = (bb.max.x - bb.min.x) * (bb.max.y - bb.min.y) * (bb.max.z - bb.min.z);
-  const IndexBox region = r.lattice.centers_within(planning_region(machine, bb, r.tolerance));
-  r.domain = {{region.lo.x - 2, region.lo.y - 2, region.lo.z - 2}, {region.hi.x + 2, region.hi.y + 2, region.hi.z + 2}};
+  r.domain = planning_domain(machine, r.lattice, bb, r.tolerance);
   r.design = intersect(r.design, Solid::filled(r.lattice, r.domain));
 }
 

@@ -1,6 +1,8 @@
 #include "planner/primitive_shapes.hpp"
 
 #include <algorithm>
+#include <optional>
+#include <variant>
 
 namespace hybridctl::planner {
 namespace {
@@ -48,6 +50,27 @@ IndexBox padded(const IndexBox& domain, const std::vector<StructuringElement>& e
           {domain.hi.x + reach, domain.hi.y + reach, domain.hi.z + reach}};
 }
 
+// An instrument as a tool sweep (geometry/morphology.hpp): one axial cutting part that
+// holds its tip (the definition's removal region keeps every free tip position, which the
+// sweep does when the cutting part holds the origin) and an axial body along it. SM-max
+// keeps the whole instrument clear of the design, SM-cons its body alone.
+std::optional<geometry::ToolSweep> as_tool_sweep(const Instrument& in, bool maximal) {
+  if (in.cutting.size() != 1) return std::nullopt;
+  const auto* cutting = std::get_if<geometry::AxialBody>(&in.cutting.front());
+  if (!cutting) return std::nullopt;
+  bool holds_tip = false;
+  for (const auto& section : cutting->sections) holds_tip = holds_tip || section.radius_squared_at(0.0) >= 0;
+  if (!holds_tip) return std::nullopt;
+  geometry::ToolSweep sweep{*cutting, {}};
+  if (maximal) sweep.clearance.push_back(*cutting);
+  for (const auto& e : in.body) {
+    const auto* body = std::get_if<geometry::AxialBody>(&e);
+    if (!body || !(body->direction == cutting->direction)) return std::nullopt;
+    sweep.clearance.push_back(*body);
+  }
+  return sweep;
+}
+
 Solid removal_region(const Solid& design, const std::vector<StructuringElement>& grow_by,
                      const std::vector<StructuringElement>& cutting, const IndexBox& domain) {
   const IndexBox work = padded(domain, cutting, design.voxel_size());
@@ -78,47 +101,25 @@ Solid subtractive_conservative(const Solid& design, const Instrument& instrument
 
 std::vector<Solid> removal_regions(const Solid& design, const std::vector<RemovalRequest>& requests, const IndexBox& domain,
                                    const std::function<void(std::size_t)>& done) {
-  const double h = design.voxel_size();
-  // One working box for all: padded by the farthest-reaching cutter.
-  std::vector<StructuringElement> all_cutting;
-  for (const auto& r : requests) all_cutting.insert(all_cutting.end(), r.instrument->cutting.begin(), r.instrument->cutting.end());
-  const IndexBox work = padded(domain, all_cutting, h);
-
-  // Every instrument's reflected cutter and body elements, once each, grown together.
-  std::vector<const Instrument*> instruments;
-  for (const auto& r : requests)
-    if (std::find(instruments.begin(), instruments.end(), r.instrument) == instruments.end()) instruments.push_back(r.instrument);
-  std::vector<StructuringElement> elements;
-  struct Span {
-    std::size_t cutting_begin, body_begin, end;
-  };
-  std::vector<Span> spans;
-  for (const Instrument* in : instruments) {
-    Span sp{elements.size(), 0, 0};
-    for (const auto& e : in->cutting) elements.push_back(geometry::reflected(e));
-    sp.body_begin = elements.size();
-    for (const auto& e : in->body) elements.push_back(geometry::reflected(e));
-    sp.end = elements.size();
-    spans.push_back(sp);
-  }
-  const std::vector<Solid> grown = geometry::dilate_each(design, elements, work);
-
-  std::vector<Solid> out;
-  out.reserve(requests.size());
+  // Cutters are axial bodies: their removal regions are tool sweeps, computed together.
+  // Anything else goes by the definition, one by one.
+  std::vector<Solid> out(requests.size());
+  std::vector<geometry::ToolSweep> sweeps;
+  std::vector<std::size_t> swept;
   for (std::size_t i = 0; i < requests.size(); ++i) {
-    const RemovalRequest& r = requests[i];
-    const Span& sp = spans[std::size_t(std::find(instruments.begin(), instruments.end(), r.instrument) - instruments.begin())];
-    const std::size_t first = r.maximal ? sp.cutting_begin : sp.body_begin;
-    Solid obstacle = design;
-    if (first < sp.end) {
-      obstacle = Solid(design.lattice(), work);
-      for (std::size_t e = first; e < sp.end; ++e) obstacle = unite(obstacle, grown[e]);
-      obstacle = intersect(obstacle, Solid::filled(design.lattice(), work));
+    if (auto sweep = as_tool_sweep(*requests[i].instrument, requests[i].maximal)) {
+      sweeps.push_back(std::move(*sweep));
+      swept.push_back(i);
+    } else {
+      const Instrument& in = *requests[i].instrument;
+      out[i] = requests[i].maximal ? subtractive_maximal(design, in, domain) : subtractive_conservative(design, in, domain);
+      if (done) done(i);
     }
-    const Solid kept = erode_union(obstacle, reflected_all(r.instrument->cutting));
-    out.push_back(subtract(Solid::filled(design.lattice(), domain), kept));
-    if (done) done(i);
   }
+  std::vector<Solid> regions = geometry::tool_sweeps(design, sweeps, domain, [&](std::size_t k) {
+    if (done) done(swept[k]);
+  });
+  for (std::size_t k = 0; k < swept.size(); ++k) out[swept[k]] = std::move(regions[k]);
   return out;
 }
 

@@ -32,11 +32,11 @@ geometry::Solid subtractive_maximal(const geometry::Solid& design, const Instrum
 geometry::Solid subtractive_conservative(const geometry::Solid& design, const Instrument& instrument,
                                          const geometry::IndexBox& domain);
 
-// Many removal regions at once: SM-max (`maximal`) or SM-cons of each instrument. The
-// design's growth by every instrument's cutter and body is computed in one batch, so
-// tools approaching along the same axis share a distance transform, and an
-// instrument's SM-max and SM-cons share its body's growth. Equal to calling
-// subtractive_maximal / subtractive_conservative one by one. `done(i)` reports region i.
+// Many removal regions at once: SM-max (`maximal`) or SM-cons of each instrument. Equal,
+// voxel for voxel, to calling subtractive_maximal / subtractive_conservative one by one
+// (the definitions above). Cutters with their shank and holder are tool sweeps
+// (geometry::tool_sweeps): tools along one axis share one distance transform across it
+// and each is then a few operations on heightmaps. `done(i)` reports region i.
 struct RemovalRequest {
   const Instrument* instrument = nullptr;
   bool maximal = true;
