@@ -67,6 +67,7 @@ json deviation_json(const Deviation& d) {
           {"worst_missing", distance_json(d.worst_missing)},
           {"worst_missing_at", place_json(d.worst_missing_at)},
           {"within_tolerance", d.within_tolerance}};
+}
 
 // plan.json's `optimality` of the plan at index k (docs/plan-format.md).
 std::string optimality(const Plan& plan, std::size_t k) {
