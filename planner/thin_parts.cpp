@@ -47,9 +47,15 @@ void cover(const AtomDecomposition& atoms, const Solid& design, const Solid& reg
   const DeepestFirst order = deepest_first(region, design, side, int(std::floor(tolerance / h)) + 1);
   const IndexBox& domain = atoms.domain();
   const bool material = side == Side::Material;
+  // A candidate's gain is counted on a sample of its ball: with a tolerance of many
+  // voxels, counting all of it for every candidate would cost the ball's size squared.
+  constexpr std::size_t kGainSamples = 125;
+  std::vector<Index3> sample;
+  for (std::size_t i = 0; i < offsets.size(); i += std::max<std::size_t>(1, offsets.size() / kGainSamples))
+    sample.push_back(offsets[i]);
   Solid pending = region;
-  auto around = [&](Index3 c, auto fn) {
-    for (const Index3& d : offsets) fn(Index3{c.x + d.x, c.y + d.y, c.z + d.z});
+  auto around = [](Index3 c, const std::vector<Index3>& ball, auto fn) {
+    for (const Index3& d : ball) fn(Index3{c.x + d.x, c.y + d.y, c.z + d.z});
   };
   for (const Index3& u : order.voxels) {
     if (!pending.contains(u) || !domain.contains(u)) continue;  // outside the domain nothing is ever made
@@ -68,12 +74,12 @@ void cover(const AtomDecomposition& atoms, const Solid& design, const Solid& reg
     // pending voxels, then the deepest (the medial core).
     std::tuple<int, int, float> best{-1, 0, 0};
     Index3 chosen{};
-    around(u, [&](Index3 v) {
+    around(u, offsets, [&](Index3 v) {
       if (!domain.contains(v) || design.contains(v) != material) return;
       const AtomMeasures& a = m[std::size_t(atoms.atom_at(v))];
       const int tier = a.sliver ? 1 : (material ? clears(a) : holds(a)) ? 0 : 2;
       int gain = 0;
-      around(v, [&](Index3 w) { gain += pending.contains(w); });
+      around(v, sample, [&](Index3 w) { gain += pending.contains(w); });
       const std::tuple<int, int, float> score{tier, gain, order.depth.squared(v)};
       if (score > best) {
         best = score;
@@ -85,7 +91,7 @@ void cover(const AtomDecomposition& atoms, const Solid& design, const Solid& reg
     (material ? a.thin_feature : a.thin_gap) = true;
     a.atom_class = class_of(a);
     if (!a.sliver)
-      around(chosen, [&](Index3 w) {
+      around(chosen, offsets, [&](Index3 w) {
         if (pending.contains(w)) pending.set(w, false);
       });
   }
