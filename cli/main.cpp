@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   add_status_command(app, runner);
   add_run_command(app, runner);
   add_dry_run_command(app, runner);
+  add_bridge_command(app, runner);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -133,6 +133,10 @@ void print_report(const drivers::JobResult& job) {
   std::printf("%s after %u of %zu lines in %.1f s (%.0f lines/s)\n", r.completed ? "completed" : "STOPPED", executed,
               job.lines, job.seconds, double(executed) / std::max(job.seconds, 1e-9));
   if (!r.completed) std::printf("why         %s\n", r.stopped_because.c_str());
+  const protocol::Status& f = r.final_status;
+  std::printf("machine     at X%.3f Y%.3f Z%.3f, tool T%u, spindle %d rpm, deposition %s, line %u, state %s\n",
+              f.x_um / 1000.0, f.y_um / 1000.0, f.z_um / 1000.0, unsigned(f.active_tool), int(f.spindle_rpm),
+              f.deposition_on ? "on" : "off", f.last_executed_line, std::string(protocol::to_string(f.state)).c_str());
   for (const drivers::ActionReport& a : job.actions) {
     const std::string time = a.seconds ? gcode::format_duration(*a.seconds) : "-";
     std::string alarms;

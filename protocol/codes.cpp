@@ -72,6 +72,19 @@ constexpr std::array<AlarmInfo, kAlarmCodeCount> kAlarms{{
      "ABORT; inspect the nozzle and the part. The program deposits under or beside material "
      "the nozzle cannot pass: re-plan or re-export it.",
      true},
+    {AlarmCode::LinuxcncError, "LINUXCNC_ERROR",
+     "LinuxCNC reported an error the other codes do not name (its error channel; the bridge "
+     "logs LinuxCNC's message) and stopped the program at the alarm line.",
+     "Read LinuxCNC's message in the bridge's log; fix the cause, RESET_ALARM and RESUME, or "
+     "ABORT.",
+     true},
+    {AlarmCode::LinuxcncLost, "LINUXCNC_LOST",
+     "The LinuxCNC bridge lost LinuxCNC (it stopped or restarted): the program in LinuxCNC, "
+     "its position and modal state are gone. When LinuxCNC is back the bridge counts a new "
+     "boot without the program.",
+     "Check the machine (position, tool, part); the host reports a controller loss and "
+     "the lines that ran; restart with `run --resume DIR --from-line N`.",
+     false},
 }};
 
 constexpr std::array<ResultInfo, kResultCodeCount> kResults{{

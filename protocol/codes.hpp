@@ -60,8 +60,10 @@ enum class AlarmCode : std::uint16_t {
   DepositionStarved = 11,
   DepositionOverAir = 12,
   NozzleCollision = 13,
+  LinuxcncError = 14,      // the LinuxCNC bridge (docs/bridge.md)
+  LinuxcncLost = 15,       // the LinuxCNC bridge (docs/bridge.md)
 };
-inline constexpr std::uint16_t kAlarmCodeCount = 14;
+inline constexpr std::uint16_t kAlarmCodeCount = 16;
 
 /// Outcome of a chunk write or a command, reported in the status block; also the kind
 /// of every decoding error. Numbers are wire values.

@@ -25,6 +25,7 @@
 
 #include "config/machine.hpp"
 #include "protocol/chunk_acceptor.hpp"
+#include "protocol/controller_port.hpp"
 #include "protocol/messages.hpp"
 #include "geometry/solid.hpp"
 
@@ -74,27 +75,27 @@ struct ControllerReport {
   bool completed = false;
 };
 
-class Controller {
+class Controller final : public protocol::ControllerPort {
  public:
   // `machine` must outlive the controller.
   Controller(const config::Machine& machine, ControllerOptions options = {});
-  ~Controller();
+  ~Controller() override;
   Controller(const Controller&) = delete;
   Controller& operator=(const Controller&) = delete;
 
   // --- the wire: each returns what the status block will report.
-  protocol::ChunkVerdict write_mailbox(std::span<const std::uint16_t> registers);  // Modbus
-  protocol::ChunkVerdict write_message(std::span<const std::uint8_t> message);     // CAN
+  protocol::ChunkVerdict write_mailbox(std::span<const std::uint16_t> registers) override;  // Modbus
+  protocol::ChunkVerdict write_message(std::span<const std::uint8_t> message) override;     // CAN
   // A command block (Modbus) or an assembled command (CAN). Repeats of the last seq are
   // ignored (protocol::CommandGate).
-  protocol::ResultCode write_command(std::span<const std::uint16_t> registers);
-  protocol::ResultCode write_command(const protocol::Command& command);
-  void write_heartbeat(std::uint16_t counter);
-  protocol::Status status() const;
+  protocol::ResultCode write_command(std::span<const std::uint16_t> registers) override;
+  protocol::ResultCode write_command(const protocol::Command& command) override;
+  void write_heartbeat(std::uint16_t counter) override;
+  protocol::Status status() const override;
   // The state and alarm of status(), without building the whole block (the CAN node
   // checks them after every step to send a snapshot when they change).
-  protocol::ControllerState state() const;
-  protocol::AlarmCode alarm() const;
+  protocol::ControllerState state() const override;
+  protocol::AlarmCode alarm() const override;
 
   // --- time: runs the program for `real_seconds` of wall time (scaled by time_scale),
   // or, at time scale 0, executes whatever is queued (bounded per call).

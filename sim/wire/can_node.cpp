@@ -28,7 +28,7 @@ CanMicros CanBusClock::reserve(CanMicros now, std::size_t data_bytes) {
   return free_at_;
 }
 
-CanNode::CanNode(Controller& controller, CanNodeOptions options)
+CanNode::CanNode(protocol::ControllerPort& controller, CanNodeOptions options)
     : controller_(controller), options_(options), commands_(options.node), reassembler_(options.node, options.reassembler) {}
 
 void CanNode::send(const can::CanFrame& frame) {

@@ -25,10 +25,10 @@
 
 #include "protocol/can_frames.hpp"
 #include "protocol/can_transfer.hpp"
+#include "protocol/controller_port.hpp"
 
 namespace hybridctl::sim {
 
-class Controller;
 
 using CanMicros = protocol::can::Micros;
 
@@ -54,7 +54,7 @@ struct CanNodeCounters {
 
 class CanNode {
  public:
-  CanNode(Controller& controller, CanNodeOptions options = {});
+  CanNode(protocol::ControllerPort& controller, CanNodeOptions options = {});
 
   /// A frame seen on the bus at `now`.
   void on_frame(const protocol::can::CanFrame& frame, CanMicros now);
@@ -81,7 +81,7 @@ class CanNode {
   void send(const protocol::can::CanFrame& frame);
   void send_status(CanMicros now);
 
-  Controller& controller_;
+  protocol::ControllerPort& controller_;
   CanNodeOptions options_;
   protocol::can::CommandAssembler commands_;
   protocol::can::CanReassembler reassembler_;

@@ -52,7 +52,7 @@ enum class Disposition {
 // construction (direct, or captured through a socket pair when a fault needs the bytes).
 class ModbusCore {
  public:
-  ModbusCore(Controller& controller, const ModbusServerOptions& options, int header_length, int checksum_length)
+  ModbusCore(protocol::ControllerPort& controller, const ModbusServerOptions& options, int header_length, int checksum_length)
       : controller_(controller), faults_(options.faults), header_length_(header_length),
         checksum_length_(checksum_length) {
     mapping_ = modbus_mapping_new_start_address(0, 0, 0, 0, 0, mb::kHoldingRegisterCount, 0, mb::kInputRegisterCount);
@@ -149,7 +149,7 @@ class ModbusCore {
     }
   }
 
-  Controller& controller_;
+  protocol::ControllerPort& controller_;
   FaultInjector faults_;
   ModbusCounters counters_;
   modbus_mapping_t* mapping_ = nullptr;
@@ -188,7 +188,7 @@ struct ModbusTcpServer::Impl {
     std::vector<std::uint8_t> reply;
   };
 
-  Impl(Controller& controller, ModbusServerOptions opts)
+  Impl(protocol::ControllerPort& controller, ModbusServerOptions opts)
       : options(std::move(opts)), core(controller, options, kTcpHeaderLength, 0) {}
 
   ModbusServerOptions options;
@@ -257,7 +257,7 @@ struct ModbusTcpServer::Impl {
   }
 };
 
-ModbusTcpServer::ModbusTcpServer(Controller& controller, const std::string& address, int port,
+ModbusTcpServer::ModbusTcpServer(protocol::ControllerPort& controller, const std::string& address, int port,
                                  ModbusServerOptions options)
     : impl_(std::make_unique<Impl>(controller, std::move(options))) {
   Impl& s = *impl_;
@@ -343,7 +343,7 @@ SteadyTime ModbusTcpServer::next_deadline() const {
 // ---------------------------------------------------------------- RTU
 
 struct ModbusRtuServer::Impl {
-  Impl(Controller& controller, ModbusRtuSettings st, ModbusServerOptions opts)
+  Impl(protocol::ControllerPort& controller, ModbusRtuSettings st, ModbusServerOptions opts)
       : settings(std::move(st)), options(std::move(opts)),
         core(controller, options, kRtuHeaderLength, kRtuChecksumLength) {}
 
@@ -391,7 +391,7 @@ struct ModbusRtuServer::Impl {
   }
 };
 
-ModbusRtuServer::ModbusRtuServer(Controller& controller, ModbusRtuSettings settings, ModbusServerOptions options)
+ModbusRtuServer::ModbusRtuServer(protocol::ControllerPort& controller, ModbusRtuSettings settings, ModbusServerOptions options)
     : impl_(std::make_unique<Impl>(controller, std::move(settings), std::move(options))) {
   Impl& s = *impl_;
   const std::string& dev = s.settings.device;

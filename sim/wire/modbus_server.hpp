@@ -34,12 +34,12 @@
 #include <memory>
 #include <string>
 
+#include "protocol/controller_port.hpp"
 #include "sim/wire/fault_injection.hpp"
 #include "sim/wire/serve_loop.hpp"
 
 namespace hybridctl::sim {
 
-class Controller;
 
 struct ModbusCounters {
   std::uint64_t connections = 0;          ///< TCP clients accepted
@@ -69,7 +69,7 @@ class ModbusTcpServer final : public WireEndpoint {
  public:
   /// Listens on `address` (an IPv4 address) and `port` (0: a free port, see port()).
   /// Throws hybridctl::InputError naming the address when it cannot listen.
-  ModbusTcpServer(Controller& controller, const std::string& address, int port, ModbusServerOptions options = {});
+  ModbusTcpServer(protocol::ControllerPort& controller, const std::string& address, int port, ModbusServerOptions options = {});
   ~ModbusTcpServer() override;
   ModbusTcpServer(const ModbusTcpServer&) = delete;
   ModbusTcpServer& operator=(const ModbusTcpServer&) = delete;
@@ -101,7 +101,7 @@ struct ModbusRtuSettings {
 class ModbusRtuServer final : public WireEndpoint {
  public:
   /// Opens the device. Throws hybridctl::InputError naming the device when it cannot.
-  ModbusRtuServer(Controller& controller, ModbusRtuSettings settings, ModbusServerOptions options = {});
+  ModbusRtuServer(protocol::ControllerPort& controller, ModbusRtuSettings settings, ModbusServerOptions options = {});
   ~ModbusRtuServer() override;
   ModbusRtuServer(const ModbusRtuServer&) = delete;
   ModbusRtuServer& operator=(const ModbusRtuServer&) = delete;

@@ -37,7 +37,7 @@ bool socketcan_available(std::string* why) {
 }
 
 struct SocketCanEndpoint::Impl {
-  Impl(Controller& controller, std::string iface, CanNodeOptions node_options, FaultOptions fault_options)
+  Impl(protocol::ControllerPort& controller, std::string iface, CanNodeOptions node_options, FaultOptions fault_options)
       : interface_name(std::move(iface)), node(controller, node_options), faults(fault_options) {}
 
   struct Outgoing {
@@ -107,7 +107,7 @@ struct SocketCanEndpoint::Impl {
   }
 };
 
-SocketCanEndpoint::SocketCanEndpoint(Controller& controller, const std::string& interface_name, CanNodeOptions node,
+SocketCanEndpoint::SocketCanEndpoint(protocol::ControllerPort& controller, const std::string& interface_name, CanNodeOptions node,
                                      FaultOptions faults)
     : impl_(std::make_unique<Impl>(controller, interface_name, node, faults)) {
   Impl& s = *impl_;

@@ -36,7 +36,7 @@ class SocketCanEndpoint final : public WireEndpoint {
  public:
   /// Opens a raw CAN socket on `interface_name`. Throws SocketCanUnavailable without
   /// AF_CAN, hybridctl::InputError for a missing interface or another failure.
-  SocketCanEndpoint(Controller& controller, const std::string& interface_name, CanNodeOptions node = {},
+  SocketCanEndpoint(protocol::ControllerPort& controller, const std::string& interface_name, CanNodeOptions node = {},
                     FaultOptions faults = {});
   ~SocketCanEndpoint() override;
   SocketCanEndpoint(const SocketCanEndpoint&) = delete;

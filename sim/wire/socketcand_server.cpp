@@ -220,7 +220,7 @@ SteadyTime to_steady(CanMicros t) { return SteadyTime(std::chrono::duration_cast
 }  // namespace
 
 struct SocketcandServer::Impl {
-  Impl(Controller& controller, SocketcandOptions opts)
+  Impl(protocol::ControllerPort& controller, SocketcandOptions opts)
       : options(std::move(opts)), node(controller, options.node), faults(options.faults), bus(options.bitrate) {}
 
   SocketcandOptions options;
@@ -448,7 +448,7 @@ struct SocketcandServer::Impl {
   }
 };
 
-SocketcandServer::SocketcandServer(Controller& controller, const std::string& address, int port,
+SocketcandServer::SocketcandServer(protocol::ControllerPort& controller, const std::string& address, int port,
                                    SocketcandOptions options)
     : impl_(std::make_unique<Impl>(controller, std::move(options))) {
   Impl& s = *impl_;

@@ -67,7 +67,7 @@ class SocketcandServer final : public WireEndpoint {
  public:
   /// Listens on `address` (IPv4) and `port` (0: a free port). Throws hybridctl::InputError
   /// naming the address when it cannot.
-  SocketcandServer(Controller& controller, const std::string& address, int port, SocketcandOptions options = {});
+  SocketcandServer(protocol::ControllerPort& controller, const std::string& address, int port, SocketcandOptions options = {});
   ~SocketcandServer() override;
   SocketcandServer(const SocketcandServer&) = delete;
   SocketcandServer& operator=(const SocketcandServer&) = delete;
