@@ -6,10 +6,13 @@
 //                                (subtractive_maximal / subtractive_conservative), the
 //                                baseline the fast path must equal voxel for voxel
 //                                (counter mismatches: regions that differ)
-//   BM_Atoms/part                the atom decomposition of those primitives
+//   BM_GridPhases/part/voxel     primitives, atoms and their measures at voxel/100 mm: all
+//                                that planning allocates before the search, next to the
+//                                estimate `plan` checks --memory-budget against
 //
-// Counters: primitives, stocks_additive_s (wall time before the first removal), atoms, peak_rss_MiB (the process's peak so far: run one benchmark
-// per process for a clean figure, e.g. --benchmark_filter=BM_MachinePrimitives/0).
+// Counters: primitives, stocks_additive_s (wall time before the first removal), atoms,
+// peak_rss_MiB (the process's peak so far: run one benchmark per process for a clean
+// figure, as bench/planning-peak-memory does), estimate_MiB.
 // Part 0 is the bracket, 1 the overhang. A run of the reference takes about a minute.
 
 #include <benchmark/benchmark.h>
@@ -38,11 +41,11 @@ struct Job {
 };
 
 // The design and domain as plan_part makes them (planner/planning.cpp, voxelize_design).
-Job job_for(int part) {
+Job job_for(int part, double voxel = 0) {
   const std::string root = HYBRIDCTL_SOURCE_DIR;
   const std::string name = part == 0 ? "bracket.stl" : "overhang.stl";
   Job j{config::load_machine(root + "/examples/machines/multitask-b-axis.yaml"), {}, {}};
-  const geometry::Lattice lattice{j.machine.planning.voxel_size, {0, 0, 0}};
+  const geometry::Lattice lattice{voxel > 0 ? voxel : j.machine.planning.voxel_size, {0, 0, 0}};
   const Solid design = geometry::voxelize(geometry::read_stl(root + "/examples/parts/" + name), lattice, name,
                                           geometry::VoxelizeMethod::ExactScan);
   j.domain = planner::planning_domain(j.machine, lattice, design.bounding_box_mm(), j.machine.planning.tolerance);
@@ -102,22 +105,31 @@ void BM_ReferenceRemovals(benchmark::State& state) {
   state.counters["peak_rss_MiB"] = peak_rss_mib();
 }
 
-void BM_Atoms(benchmark::State& state) {
-  const Job j = job_for(int(state.range(0)));
-  const auto primitives = planner::machine_primitives(j.machine, j.design, j.domain);
+// Everything plan_part allocates before the search, at a voxel size of range(1) / 100 mm:
+// primitives, atoms, the tolerance zone and the atoms' measures; next to the estimate
+// `plan` checks against --memory-budget (planner/memory_estimate.hpp).
+void BM_GridPhases(benchmark::State& state) {
+  const double voxel = double(state.range(1)) / 100.0;
+  const Job j = job_for(int(state.range(0)), voxel);
   int atoms = 0;
   for (auto _ : state) {
+    const auto primitives = planner::machine_primitives(j.machine, j.design, j.domain);
     planner::AtomDecomposition d(j.design.lattice(), j.domain);
     for (const auto& p : primitives) d.add_primitive(p.region);
-    atoms = d.atom_count();
+    const auto measures = planner::measure_atoms(d, j.design, planner::make_tolerance_zone(j.design, j.machine.planning.tolerance),
+                                                 j.machine.planning.sliver_threshold);
+    atoms = int(measures.size());
   }
+  const auto part = j.design.bounding_box_mm();
+  const planner::PlanningMemory estimate = planner::planning_memory(part, j.machine, voxel, j.machine.planning.tolerance);
   state.counters["atoms"] = atoms;
   state.counters["peak_rss_MiB"] = peak_rss_mib();
+  state.counters["estimate_MiB"] = estimate.total() / (1024.0 * 1024.0);
 }
 
 BENCHMARK(BM_MachinePrimitives)->Arg(0)->Arg(1)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 BENCHMARK(BM_ReferenceRemovals)->Arg(0)->Arg(1)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
-BENCHMARK(BM_Atoms)->Arg(0)->Arg(1)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+BENCHMARK(BM_GridPhases)->ArgsProduct({{0, 1}, {50, 25}})->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
 }  // namespace
 

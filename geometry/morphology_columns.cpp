@@ -228,20 +228,32 @@ void disc_minimum(const std::vector<std::int32_t>& h, const Columns& q, double r
   });
 }
 
-// The voxels of `domain` at or above the swept height of their column.
+// The voxels of `domain` at or above the swept height of their column (u = sign * the
+// coordinate along `a`), a row of X at a time.
 Solid solid_above(const std::vector<std::int32_t>& lowest, const Columns& d, Axis a, int sign, const Lattice& lattice,
                   const IndexBox& domain) {
   Solid out(lattice, domain);
-  const Axis au = across_u(a), av = across_v(a);
+  const int x0 = domain.lo.x, x1 = domain.hi.x;
   tbb::parallel_for(tbb::blocked_range<int>(domain.lo.z, domain.hi.z), [&](const tbb::blocked_range<int>& r) {
     for (int z = r.begin(); z != r.end(); ++z)
       for (int y = domain.lo.y; y < domain.hi.y; ++y) {
+        if (a == Axis::X) {
+          // The row is the column: one run.
+          const std::int64_t from = lowest[d.index(y, z)];
+          const std::int64_t lo = sign > 0 ? std::max<std::int64_t>(x0, from) : x0;
+          const std::int64_t hi = sign > 0 ? x1 : std::min<std::int64_t>(x1, -from + 1);
+          if (lo < hi) out.set_run(y, z, int(lo), int(hi));
+          continue;
+        }
+        // Along Y the row's columns are (x, z), along Z (x, y): x runs along the heightmap.
+        const std::int32_t u = sign * (a == Axis::Y ? y : z);
+        const std::int32_t* from = lowest.data() + (a == Axis::Y ? d.index(x0, z) : d.index(x0, y)) - x0;  // by x
         auto words = out.row(y, z);
-        for (int x = domain.lo.x; x < domain.hi.x; ++x) {
-          const Index3 p{x, y, z};
-          const std::int32_t u = sign * coordinate(p, a);
-          if (u >= lowest[d.index(coordinate(p, au), coordinate(p, av))])
-            words[std::size_t((x >> 6) - out.first_word())] |= std::uint64_t{1} << (x & 63);
+        for (int x = x0; x < x1;) {
+          const int word = x >> 6, end = std::min(x1, (word + 1) * 64);
+          std::uint64_t bits = 0;
+          for (; x < end; ++x) bits |= std::uint64_t(u >= from[x]) << (x & 63);
+          words[std::size_t(word - out.first_word())] |= bits;
         }
       }
   });

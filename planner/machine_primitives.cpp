@@ -50,14 +50,19 @@ Instrument tool_instrument(const config::CuttingTool& tool, config::Approach app
   return in;
 }
 
+std::size_t machine_primitive_count(const config::Machine& m) {
+  std::size_t total = m.raw_stocks.size();
+  for (const auto& head : m.heads) total += m.setups.size() * head.primitives.size();
+  for (const auto& tool : m.tools) total += m.setups.size() * tool.primitives.size();
+  return total;
+}
+
 std::vector<Primitive> machine_primitives(const config::Machine& m, const Solid& design,
                                           const geometry::IndexBox& domain, const PrimitiveProgress& progress) {
   std::vector<Primitive> out;
   const geometry::Lattice& lattice = design.lattice();
   const geometry::Box3 bb = design.bounding_box_mm();
-  std::size_t total = m.raw_stocks.size();
-  for (const auto& head : m.heads) total += m.setups.size() * head.primitives.size();
-  for (const auto& tool : m.tools) total += m.setups.size() * tool.primitives.size();
+  const std::size_t total = machine_primitive_count(m);
   auto add = [&](Primitive p, const std::function<Solid()>& make) {
     if (progress) progress(out.size(), total, p.label);
     p.region = make();

@@ -39,6 +39,10 @@ Instrument tool_instrument(const config::CuttingTool& tool, config::Approach app
 // Called with a message before each primitive is computed.
 using PrimitiveProgress = std::function<void(std::size_t done, std::size_t total, const std::string& what)>;
 
+// How many primitives machine_primitives returns: every raw stock, and every head's and
+// tool's primitive kinds over the setups.
+std::size_t machine_primitive_count(const config::Machine& machine);
+
 // Stocks first, then heads, then tools, each over the machine's setups.
 std::vector<Primitive> machine_primitives(const config::Machine& machine, const geometry::Solid& design,
                                           const geometry::IndexBox& domain, const PrimitiveProgress& progress = {});

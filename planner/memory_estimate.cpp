@@ -4,6 +4,8 @@
 #include <cstdio>
 
 #include "geometry/memory_estimate.hpp"
+#include "instruments/cutter.hpp"
+#include "planner/machine_primitives.hpp"
 
 namespace hybridctl::planner {
 namespace {
@@ -47,21 +49,56 @@ geometry::IndexBox planning_domain(const config::Machine& m, const geometry::Lat
   return {{region.lo.x - 2, region.lo.y - 2, region.lo.z - 2}, {region.hi.x + 2, region.hi.y + 2, region.hi.z + 2}};
 }
 
-double planning_memory_bytes(const Box3& part_bounds, const config::Machine& m, double h, double tolerance) {
+namespace {
+
+// The voxels the morphology's dense grids cover: the planning region grown by the widest
+// cutter across its axis (tool sweeps keep the distances across an axis over the columns
+// a cutter reaches) or, for a tool whose body narrows (a reduced neck: its sweeps take
+// dilations over the tip positions), by its cutting length too.
+double scratch_grid_voxels(const Box3& region, const config::Machine& m, double h) {
+  double reach = 0;
+  for (const auto& tool_in : m.tools) {
+    const config::CuttingTool tool = instruments::with_defaults(tool_in);
+    reach = std::max(reach, tool.diameter / 2);
+    if (tool.shank.diameter < tool.diameter || tool.holder.diameter < tool.shank.diameter)
+      reach = std::max(reach, tool.diameter / 2 + tool.flute_length);
+  }
+  return geometry::grid_voxels(grown(region, reach), h, 2);
+}
+
+}  // namespace
+
+PlanningMemory planning_memory(const Box3& part_bounds, const config::Machine& m, double h, double tolerance) {
   const Box3 region = planning_region(m, part_bounds, tolerance);
-  const double voxels = geometry::grid_voxels(region, h, 2);
-  // Primitives: per head and tool a few (orientations, modes), one per raw stock.
-  const double primitives = 2.0 * double(m.heads.size() + m.tools.size()) + double(m.raw_stocks.size());
-  return 4.0 * voxels + (primitives + 6) * geometry::solid_bytes(region, h, 2);
+  PlanningMemory mem;
+  mem.primitives = machine_primitive_count(m);
+  mem.voxel_set = geometry::solid_bytes(region, h, 2);
+  // Design, tolerance core and hull, the plan outcomes (top_k) and two operands of a CSG step.
+  mem.other_voxel_sets = 5 + std::size_t(std::max(1, m.planning.top_k));
+  mem.voxel_sets = double(mem.primitives + mem.other_voxel_sets) * mem.voxel_set;
+  mem.atom_labels = 4.0 * geometry::grid_voxels(region, h, 2);
+  // Distances across an axis (4 bytes a voxel) and a sweep's bytes (1): one of each in use
+  // at a time. bench/planning-peak-memory measures the process's peak (program included)
+  // below the estimate.
+  mem.scratch = (4.0 + 1.0) * scratch_grid_voxels(region, m, h);
+  return mem;
+}
+
+double planning_memory_bytes(const Box3& part_bounds, const config::Machine& m, double h, double tolerance) {
+  return planning_memory(part_bounds, m, h, tolerance).total();
 }
 
 void check_planning_memory(const Box3& part_bounds, const config::Machine& m, double h, double tolerance, std::uint64_t budget,
                            const std::string& part_name) {
   char voxel[32];
   std::snprintf(voxel, sizeof voxel, "%g", h);
+  const PlanningMemory mem = planning_memory(part_bounds, m, h, tolerance);
+  const std::string what = "planning " + part_name + " at " + voxel + " mm (" + std::to_string(mem.primitives) +
+                           " primitives and " + std::to_string(mem.other_voxel_sets) + " other voxel sets of " + geometry::format_bytes(mem.voxel_set) + " each, atom labels " +
+                           geometry::format_bytes(mem.atom_labels) + ", morphology's grids " +
+                           geometry::format_bytes(mem.scratch) + ")";
   geometry::check_memory_budget([&](double v) { return planning_memory_bytes(part_bounds, m, v, tolerance); }, h,
-                                budget ? budget : geometry::default_memory_budget(),
-                                "planning " + part_name + " at " + voxel + " mm");
+                                budget ? budget : geometry::default_memory_budget(), what);
 }
 
 }  // namespace hybridctl::planner

@@ -18,12 +18,23 @@ geometry::Box3 planning_region(const config::Machine& machine, const geometry::B
 geometry::IndexBox planning_domain(const config::Machine& machine, const geometry::Lattice& lattice,
                                    const geometry::Box3& design, double tolerance);
 
-// Bytes planning takes at voxel size h: the atom labels (4 bytes a domain voxel) and the
-// dense solids alive at once (design, tolerance zone, one per primitive, plan outcomes).
+// What planning allocates at voxel size h, in bytes, before the search: measured against
+// peak RSS by bench/planning-peak-memory (docs/hardening.md, "Memory budget").
+struct PlanningMemory {
+  std::size_t primitives = 0;        // machine_primitive_count
+  std::size_t other_voxel_sets = 0;  // design, tolerance core and hull, plan outcomes, operands
+  double voxel_set = 0;         // one dense bit grid over the planning domain
+  double voxel_sets = 0;        // the primitives' and the others'
+  double atom_labels = 0;       // 4 bytes a domain voxel
+  double scratch = 0;           // the dense grids of morphology (distances across an axis, sweeps)
+  double total() const { return voxel_sets + atom_labels + scratch; }
+};
+PlanningMemory planning_memory(const geometry::Box3& part_bounds, const config::Machine& machine, double h, double tolerance);
 double planning_memory_bytes(const geometry::Box3& part_bounds, const config::Machine& machine, double h, double tolerance);
 
 // Throws InputError (exit 3) when planning at h would exceed `budget` bytes (0: the
-// default budget), with the estimate, the budget and the smallest voxel size that fits.
+// default budget), with the estimate and what takes it, the budget and the smallest voxel
+// size that fits.
 void check_planning_memory(const geometry::Box3& part_bounds, const config::Machine& machine, double h, double tolerance,
                            std::uint64_t budget, const std::string& part_name);
 
