@@ -140,8 +140,8 @@ bool in_block_order(const PlanningProblem& p, int last, int next) {
 class Search {
  public:
   Search(const PlanningProblem& p, const SearchOptions& o, const LowerBound& bound, Clock::time_point deadline,
-         const std::set<std::vector<int>>& known, SearchStats& st)
-      : p_(p), o_(o), bound_(bound), deadline_(deadline), known_(known), st_(st) {}
+         const std::set<std::vector<int>>& known, SearchStats& st, double prune_at = kInfinity)
+      : p_(p), o_(o), bound_(bound), deadline_(deadline), known_(known), st_(st), prune_at_(prune_at) {}
 
   // Accepted plans not in `known`, cheapest first (by f), at most `wanted`.
   std::vector<Plan> run(int wanted);
@@ -171,6 +171,7 @@ class Search {
   Clock::time_point deadline_;
   const std::set<std::vector<int>>& known_;
   SearchStats& st_;
+  double prune_at_;  // plans costing this or more are of no use
   std::deque<Node> nodes_;  // no reallocation: memory grows by blocks
   std::priority_queue<Entry, std::vector<Entry>, Worse> open_;
   std::int64_t seq_ = 0;
@@ -205,7 +206,7 @@ void Search::expand(int id) {
     // The quick bound orders the child for now; the full one is computed when it comes
     // up (most children never do).
     const double h = bound_.quick(child.state, child.uses, i);
-    if (h == kInfinity) continue;
+    if (h == kInfinity || child.g + h >= prune_at_) continue;
     ++st_.generated;
     nodes_.push_back(std::move(child));
     open_.push({nodes_.back().g + o_.weight * h, nodes_.back().g, seq_++, int(nodes_.size()) - 1});
@@ -231,7 +232,7 @@ std::vector<Plan> Search::run(int wanted) {
       node.bounded = true;
       const double h = bound_(node.state, node.uses, node.primitive);
       open_.pop();
-      if (h == kInfinity) continue;
+      if (h == kInfinity || node.g + h >= prune_at_) continue;
       open_.push({node.g + o_.weight * h, node.g, e.seq, e.node});
       continue;
     }
@@ -281,12 +282,17 @@ bool is_goal(const PlanningProblem& p, const AtomSet& state) {
 
 namespace {
 
-// Plans from weighted A* at growing weights until `want` plans are known, each new one
-// not among `known`.
+// Plans from weighted A*, greedy first so that a plan comes soon, then at lower weights
+// for cheaper ones while limits and time allow: the cheapest distinct ones found fill the
+// slots the exact search left. A later search skips what cannot beat the dearest plan
+// kept (g + h at least its cost).
 void fill_with_weighted(const PlanningProblem& p, const SearchOptions& options, const LowerBound& bound,
                         Clock::time_point start, std::vector<Plan>& plans, SearchStats& st) {
-  const double weights[] = {2.0, 5.0, 50.0};
-  for (std::size_t k = 0; k < std::size(weights) && int(plans.size()) < options.top_k; ++k) {
+  const double weights[] = {50.0, 5.0, 2.0};
+  const std::size_t exact = plans.size();
+  const int slots = options.top_k - int(exact);
+  auto by_cost = [](const Plan& a, const Plan& b) { return a.cost < b.cost; };
+  for (std::size_t k = 0; k < std::size(weights); ++k) {
     if (st.rejected >= options.max_rejected) break;
     Clock::time_point deadline = Clock::time_point::max();
     if (options.time_limit > 0) {
@@ -302,16 +308,19 @@ void fill_with_weighted(const PlanningProblem& p, const SearchOptions& options, 
     weighted.weight = weights[k];
     SearchStats local;
     local.rejected = st.rejected;
-    Search search(p, weighted, bound, deadline, known, local);
-    std::vector<Plan> found = search.run(options.top_k - int(plans.size()));
+    const bool full = int(plans.size() - exact) >= slots;
+    Search search(p, weighted, bound, deadline, known, local, full ? plans.back().cost : kInfinity);
+    std::vector<Plan> found = search.run(slots);
     st.expanded += local.expanded;
     st.generated += local.generated;
     st.rejected = local.rejected;
-    if (!found.empty()) st.weight = weights[k];
     for (Plan& plan : found) {
       plan.exact = false;
       plans.push_back(std::move(plan));
     }
+    std::stable_sort(plans.begin() + std::ptrdiff_t(exact), plans.end(), by_cost);
+    if (int(plans.size() - exact) > slots) plans.resize(exact + std::size_t(slots));
+    if (!found.empty()) st.weight = weights[k];
   }
 }
 

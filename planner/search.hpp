@@ -112,10 +112,12 @@ struct SearchOptions {
 
 // The k cheapest distinct accepted plans, cheapest first, by A* with the admissible and
 // consistent bound of planner/search_bound.hpp. When the exact search stops at a limit
-// (expansions, states, half the time budget) before k plans, weighted A* (w = 2, then 5,
-// then 50) fills the list with plans not yet found, cheapest first, each with its proven
-// gap against the exact search's lower bound (Plan::gap, Plan::exact,
-// SearchStats::lower_bound). With options.weight > 1 only that weighted search runs.
+// (expansions, states, half the time budget) before k plans, weighted A* fills the list:
+// w = 50 first (nearly greedy: a plan soon), then w = 5 and w = 2 for cheaper ones, each
+// within the same limits and skipping what cannot beat the plans kept; the cheapest
+// distinct plans found are kept, each with its proven gap against the exact search's
+// lower bound (Plan::gap, Plan::exact, SearchStats::lower_bound). With options.weight > 1
+// only that weighted search runs.
 std::vector<Plan> find_plans(const PlanningProblem& problem, const SearchOptions& options = {},
                              SearchStats* stats = nullptr);
 

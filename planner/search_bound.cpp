@@ -29,10 +29,18 @@ std::vector<int> ids_of(const PlanningProblem& p, bool setups) {
 
 }  // namespace
 
-// Per atom, the cheapest rate at which a primitive still allowed deposits (or removes) it.
+// Which primitives may still be used, and per atom the cheapest rate at which one of them
+// deposits (or removes) it, looked up when asked (usually the first in the list).
 struct LowerBound::Rates {
-  std::vector<double> deposit, remove;
+  const LowerBound& bound;
   std::vector<bool> allowed;
+  double cheapest(const std::vector<int>& suppliers) const {
+    for (int i : suppliers)
+      if (allowed[std::size_t(i)]) return bound.p_.primitives[std::size_t(i)].cost_per_mm3;
+    return kInfinity;
+  }
+  double deposit(std::size_t a) const { return cheapest(bound.adders_[a]); }
+  double remove(std::size_t a) const { return cheapest(bound.removers_[a]); }
 };
 
 LowerBound::LowerBound(const PlanningProblem& p)
@@ -63,21 +71,9 @@ LowerBound::LowerBound(const PlanningProblem& p)
 }
 
 LowerBound::Rates LowerBound::rates(const std::vector<std::uint8_t>& uses, bool first) const {
-  Rates r;
-  r.allowed.resize(p_.primitives.size());
+  Rates r{*this, std::vector<bool>(p_.primitives.size())};
   for (std::size_t i = 0; i < p_.primitives.size(); ++i)
     r.allowed[i] = uses[i] < p_.max_uses && (first || !p_.primitives[i].raw_stock);
-  auto cheapest = [&](const std::vector<int>& suppliers) {
-    for (int i : suppliers)
-      if (r.allowed[std::size_t(i)]) return p_.primitives[std::size_t(i)].cost_per_mm3;
-    return kInfinity;
-  };
-  r.deposit.resize(std::size_t(atoms_));
-  r.remove.resize(std::size_t(atoms_));
-  for (std::size_t a = 0; a < std::size_t(atoms_); ++a) {
-    r.deposit[a] = cheapest(adders_[a]);
-    r.remove[a] = cheapest(removers_[a]);
-  }
   return r;
 }
 
@@ -87,11 +83,11 @@ double LowerBound::atom_part(const AtomSet& state, const Rates& r) const {
   for (std::size_t w = 0; w < s.size(); ++w) {
     for (std::uint64_t b = must_in_[w] & ~s[w]; b; b &= b - 1) {
       const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
-      h += r.deposit[a] * p_.atoms[a].volume;
+      h += r.deposit(a) * p_.atoms[a].volume;
     }
     for (std::uint64_t b = must_out_[w] & s[w]; b; b &= b - 1) {
       const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
-      h += r.remove[a] * p_.atoms[a].volume;
+      h += r.remove(a) * p_.atoms[a].volume;
     }
   }
   return h;  // infinite when some needed atom has no supplier left
@@ -115,8 +111,8 @@ double LowerBound::side_effects(const AtomSet& state, const Rates& r) const {
         const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
         const AtomSpec& atom = p_.atoms[a];
         const bool undo = prim.mode == Mode::Additive ? atom.must_out : atom.must_in;
-        c += atom.volume * (prim.mode == Mode::Additive ? r.deposit[a] + (undo ? r.remove[a] : 0)
-                                                        : r.remove[a] + (undo ? r.deposit[a] : 0));
+        c += atom.volume * (prim.mode == Mode::Additive ? r.deposit(a) + (undo ? r.remove(a) : 0)
+                                                        : r.remove(a) + (undo ? r.deposit(a) : 0));
       }
     }
     side[i] = c;
@@ -173,11 +169,10 @@ double LowerBound::fixed_part(const AtomSet& state, const std::vector<std::uint8
     if (tool >= 0 && one_tool) tool_forced[std::size_t(tool)] = true;
     if (setup >= 0 && one_setup) setup_forced[std::size_t(setup)] = true;
   };
-  for_each_bit(s, [&](int a) {
-    if (p_.atoms[std::size_t(a)].must_out) force(removers_[std::size_t(a)]);
-  });
-  for (std::size_t w = 0; w < s.size(); ++w)
+  for (std::size_t w = 0; w < s.size(); ++w) {
+    for (std::uint64_t b = must_out_[w] & s[w]; b; b &= b - 1) force(removers_[w * 64 + std::size_t(std::countr_zero(b))]);
     for (std::uint64_t b = must_in_[w] & ~s[w]; b; b &= b - 1) force(adders_[w * 64 + std::size_t(std::countr_zero(b))]);
+  }
   // Each forced tool other than the current one is changed to at least once; at the
   // start, the first action's tool comes free.
   auto changes = [&](const std::vector<bool>& forced, int current) {

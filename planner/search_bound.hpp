@@ -39,6 +39,7 @@ class LowerBound {
 
  private:
   struct Rates;
+  friend struct Rates;
   Rates rates(const std::vector<std::uint8_t>& uses, bool first) const;
   double atom_part(const AtomSet& state, const Rates& r) const;
   double side_effects(const AtomSet& state, const Rates& r) const;
