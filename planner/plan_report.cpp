@@ -41,6 +41,56 @@ json atom_ids(const AtomSet& set, int atoms) {
 
 std::string fixed(double v, int digits) { return fixed_number(v, digits); }
 
+json reason_json(const RejectionReason& reason) {
+  json j = {{"kind", reason.kind}};
+  if (reason.action > 0) j["action"] = reason.action;
+  if (reason.line > 0) j["line"] = reason.line;
+  if (!reason.message.empty()) j["message"] = reason.message;
+  if (reason.where) j["where"] = vec(*reason.where);
+  return j;
+}
+
+// Candidates that validation by execution turned down, with their located reasons.
+json rejected_json(const PlanningResult& r) {
+  json rejected = json::array();
+  for (const RejectedPlan& candidate : r.rejected) {
+    json steps = json::array();
+    for (std::size_t s = 0; s < candidate.plan.steps.size(); ++s) {
+      const PlanStep& step = candidate.plan.steps[s];
+      const Primitive& prim = r.primitives[std::size_t(step.primitive)];
+      steps.push_back({{"step", s + 1},
+                       {"primitive", prim.name},
+                       {"mode", mode_name(prim.mode)},
+                       {"volume", step.volume},
+                       {"cost", step.cost}});
+    }
+    json reasons = json::array();
+    for (const RejectionReason& reason : candidate.reasons) reasons.push_back(reason_json(reason));
+    rejected.push_back({{"expression", expression(r.problem, candidate.plan)},
+                        {"cost", candidate.plan.cost},
+                        {"steps", steps},
+                        {"reasons", reasons}});
+  }
+  return rejected;
+}
+
+// One line per candidate that failed when executed, with its first reasons.
+std::string rejected_summary(const PlanningResult& r) {
+  std::ostringstream os;
+  os << "validated   every plan offered was exported and executed from the raw stock; " << r.rejected.size()
+     << " candidate" << (r.rejected.size() == 1 ? "" : "s") << " rejected\n";
+  constexpr std::size_t kReasonsShown = 2;
+  for (const RejectedPlan& candidate : r.rejected) {
+    os << "  x " << expression(r.problem, candidate.plan) << "  cost " << fixed(candidate.plan.cost, 4) << ": "
+       << candidate.reasons.size() << " reason" << (candidate.reasons.size() == 1 ? "" : "s") << "\n";
+    for (std::size_t i = 0; i < candidate.reasons.size() && i < kReasonsShown; ++i)
+      os << "      " << candidate.reasons[i].kind << ": " << describe(candidate.reasons[i]) << "\n";
+    if (candidate.reasons.size() > kReasonsShown)
+      os << "      ... " << candidate.reasons.size() - kReasonsShown << " more in plan.json\n";
+  }
+  return os.str();
+}
+
 }  // namespace
 
 std::string path_from_plan_directory(const std::string& path, const std::filesystem::path& directory) {
@@ -156,6 +206,8 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
                      {"actions", actions}});
   }
   doc["plans"] = plans;
+  doc["validated"] = r.validated;
+  doc["rejected"] = rejected_json(r);
   json timings = json::object();
   for (const auto& [phase, seconds] : r.timings) timings[phase] = seconds;
   doc["timings_s"] = timings;
@@ -235,6 +287,7 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
   const std::size_t shown = std::min<std::size_t>(r.verdict.violations.size(), 10);
   for (std::size_t i = 0; i < shown; ++i) os << "  - " << r.verdict.violations[i].description << "\n";
   if (r.verdict.violations.size() > shown) os << "  ... and " << r.verdict.violations.size() - shown << " more in plan.json\n";
+  if (r.validated) os << rejected_summary(r);
   if (!r.plans.empty()) {
     os << "plans       " << r.plans.size() << " (A*: " << r.search.expanded << " states expanded";
     if (r.search.weight > 1)

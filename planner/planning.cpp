@@ -1,5 +1,6 @@
 #include "planner/planning.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -131,14 +132,41 @@ PlanningProblem symbolic_problem(const PlanningResult& r, const config::Planning
   return p;
 }
 
-void search_plans(int top_k, std::int64_t max_expansions, const Progress& progress, PlanningResult& r) {
+// The search's accept hook from PlanningOptions::validate: rejected plans are kept with
+// their reasons (once each, as a weighted search may find them again), and the time the
+// validation takes is counted apart from the search's.
+std::function<bool(const Plan&)> accept_hook(const PlanningOptions& options, PlanningResult& r, double& seconds) {
+  if (!options.validate) return {};
+  return [&options, &r, &seconds](const Plan& plan) {
+    const auto same_actions = [&plan](const RejectedPlan& known) {
+      return std::equal(known.plan.steps.begin(), known.plan.steps.end(), plan.steps.begin(), plan.steps.end(),
+                        [](const PlanStep& a, const PlanStep& b) { return a.primitive == b.primitive; });
+    };
+    if (std::any_of(r.rejected.begin(), r.rejected.end(), same_actions)) return false;
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<RejectionReason> reasons = options.validate(r, plan);
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (reasons.empty()) return true;
+    r.rejected.push_back({plan, std::move(reasons)});
+    return false;
+  };
+}
+
+void search_plans(int top_k, const PlanningOptions& options, const Progress& progress, PlanningResult& r,
+                  double& validation_seconds) {
   progress("search", 0);
-  SearchOptions search{top_k, max_expansions};
+  SearchOptions search;
+  search.top_k = top_k;
+  search.max_expansions = options.max_expansions;
+  search.accept = accept_hook(options, r, validation_seconds);
+  search.max_rejected = options.max_rejected;
+  r.validated = bool(options.validate);
   r.plans = find_plans(r.problem, search, &r.search);
   // When the exact search runs out of room before any plan, weighted A* still finds
   // plans, with a proven bound on how far from the optimum they may be.
   for (double w : {2.0, 5.0}) {
     if (!r.plans.empty() || !r.search.limit_reached) break;
+    if (search.accept && r.search.rejected >= search.max_rejected) break;  // stopped by rejections, not by size
     progress("search", 0.5);
     search.weight = w;
     r.plans = find_plans(r.problem, search, &r.search);
@@ -146,7 +174,10 @@ void search_plans(int top_k, std::int64_t max_expansions, const Progress& progre
   progress("search", 1);
   if (r.plans.empty() && !r.verdict.decided_without_search) {
     r.verdict.manufacturable = false;
-    r.verdict.summary = r.search.limit_reached
+    r.verdict.summary = !r.rejected.empty()
+                            ? "every candidate plan failed when executed (" + std::to_string(r.rejected.size()) +
+                                  " rejected" + (r.search.limit_reached ? ", the search stopped at its limit" : "") + ")"
+                        : r.search.limit_reached
                             ? "undecided: no plan found within the search limits (" + std::to_string(r.search.expanded) +
                                   " states expanded, weighted A* included); no atom rules the part out, but the "
                                   "primitives may not combine into it"
@@ -180,8 +211,14 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
   r.problem = symbolic_problem(r, defaults, options.max_uses);
   r.verdict = check_manufacturability(r.problem, r.measures, r.lattice);
   clock.lap("check");
-  if (r.verdict.manufacturable) search_plans(top_k, options.max_expansions, progress, r);
+  double validation_seconds = 0;
+  if (r.verdict.manufacturable) search_plans(top_k, options, progress, r, validation_seconds);
   clock.lap("search");
+  if (r.validated) {
+    // The search's lap holds the validation it called: report them apart.
+    r.timings.back().second = std::max(0.0, r.timings.back().second - validation_seconds);
+    r.timings.emplace_back("validate", validation_seconds);
+  }
   for (const Plan& plan : r.plans)
     r.deviations.push_back(measure_deviation(plan_outcome(r, plan), r.design, r.domain, r.tolerance));
   clock.lap("deviation");

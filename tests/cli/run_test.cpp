@@ -406,7 +406,7 @@ TEST_F(Run, DryRunComparesAsBuiltWithAsPlanned) {
   // The replay bounds of docs/export.md: overfill within 10 %, left empty within 2 %.
   EXPECT_LE(extra, 0.10 * planned);
   EXPECT_LE(missing, 0.02 * planned);
-  EXPECT_TRUE(slurp(dir_ / "out" / "executed-lines.ngc") == slurp(dir_ / "out" / "job" / "program.ngc"));
+  EXPECT_TRUE(slurp(dir_ / "out" / "plan-1" / "executed-lines.ngc") == slurp(dir_ / "out" / "plan-1" / "job" / "program.ngc"));
 }
 
 }  // namespace
