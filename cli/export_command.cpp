@@ -79,9 +79,12 @@ int export_plan_programs(const planner::PlanFile& file, const ExportRequest& req
     for (const std::string& w : a.program.path.warnings) std::printf("       warning: %s\n", w.c_str());
   }
   const planner::Deviation& d = run.deviation;
-  std::printf("executed    from the raw stock: %zu lines, no incident; as built %.1f mm³ over, %.1f mm³ under the "
-              "design, worst %.2f mm (tolerance %.2f mm)\n",
-              run.program.lines.size(), d.over_volume, d.under_volume, d.worst_distance, file.tolerance);
+  std::printf("executed    from the raw stock: %zu lines; as built %.1f mm³ over, %.1f mm³ under the design, worst "
+              "%.2f mm (tolerance %.2f mm, %s)\n",
+              run.program.lines.size(), d.over_volume, d.under_volume, d.worst_distance, file.tolerance,
+              d.within_tolerance ? "within" : "OUTSIDE");
+  for (const planner::RejectionReason& r : run.reasons)
+    std::printf("  warning: %s: %s\n", r.kind.c_str(), planner::describe(r).c_str());
   std::printf("wrote       %s, %zu action programs and tool.tbl in %s\n", written.program.filename().string().c_str(),
               written.actions.size(), request.output.c_str());
   return kSuccess;
@@ -94,7 +97,8 @@ void add_export_command(CLI::App& app, Runner& runner) {
                                  "one program per action plus one for the whole plan, and a LinuxCNC tool table; "
                                  "each action planned against the material the ones before it leave, the program "
                                  "executed on the simulated machine from the raw stock first (exit 4 and nothing "
-                                 "written when the plan does not make the part)");
+                                 "written on a skipped layer, an unreachable region, a rapid or body into material, a "
+                                 "gouge or a refused line)");
   cmd->add_option("PLAN", request->plan, "plan.json (or its directory) written by `hybridctl plan -o`")->required();
   cmd->add_option("-o,--output", request->output, "Directory for the programs (created if missing)")->required();
   cmd->add_option("--plan", request->rank, "Which plan, by rank (1 = cheapest)")->default_val(1)->check(greater_than(0));

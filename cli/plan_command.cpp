@@ -28,7 +28,7 @@ struct PlanArgs {
   int reuse = 1;
   std::vector<std::string> primitive_files;
   bool no_validate = false;
-  int max_rejected = 20;
+  int max_rejected = 200;
 };
 
 planner::PrimitiveFile parse_primitive_argument(const std::string& arg) {

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -79,14 +80,26 @@ std::string rejected_summary(const PlanningResult& r) {
   std::ostringstream os;
   os << "validated   every plan offered was exported and executed from the raw stock; " << r.rejected.size()
      << " candidate" << (r.rejected.size() == 1 ? "" : "s") << " rejected\n";
-  constexpr std::size_t kReasonsShown = 2;
+  // One line each: the expression, the cost and the first reason, short; a reason told in
+  // full once (candidates that begin the same way fail the same way).
+  std::vector<std::string> told;
   for (const RejectedPlan& candidate : r.rejected) {
-    os << "  x " << expression(r.problem, candidate.plan) << "  cost " << fixed(candidate.plan.cost, 4) << ": "
-       << candidate.reasons.size() << " reason" << (candidate.reasons.size() == 1 ? "" : "s") << "\n";
-    for (std::size_t i = 0; i < candidate.reasons.size() && i < kReasonsShown; ++i)
-      os << "      " << candidate.reasons[i].kind << ": " << describe(candidate.reasons[i]) << "\n";
-    if (candidate.reasons.size() > kReasonsShown)
-      os << "      ... " << candidate.reasons.size() - kReasonsShown << " more in plan.json\n";
+    os << "  x " << expression(r.problem, candidate.plan) << "  cost " << fixed(candidate.plan.cost, 4);
+    if (candidate.reasons.empty()) {
+      os << "\n";
+      continue;
+    }
+    const RejectionReason& first = candidate.reasons.front();
+    const std::string text = describe(first);
+    const bool again = std::find(told.begin(), told.end(), text) != told.end();
+    os << ": " << first.kind;
+    if (again)
+      os << " (as above" << (first.action > 0 ? ", action " + std::to_string(first.action) : std::string()) << ")";
+    else
+      os << ": " << text;
+    if (candidate.reasons.size() > 1) os << "; " << candidate.reasons.size() - 1 << " more in plan.json";
+    os << "\n";
+    if (!again) told.push_back(text);
   }
   return os.str();
 }

@@ -45,7 +45,7 @@ struct PlanningOptions {
   // recorded in PlanningResult::rejected and the search goes on to the next candidate,
   // until top_k plans are kept, the plans run out, or `max_rejected` were turned down.
   std::function<std::vector<RejectionReason>(const PlanningResult&, const Plan&)> validate;
-  std::int64_t max_rejected = 20;
+  std::int64_t max_rejected = 200;
 };
 
 // A candidate plan that validation turned down, with its reasons.

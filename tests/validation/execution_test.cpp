@@ -55,8 +55,8 @@ struct Case {
   int deposit(const Solid& region, const std::string& setup = "top") {
     return add("u-am", planner::Mode::Additive, "ded", setup, region);
   }
-  int mill(const Solid& region, int tool) {
-    return add("sm-cons", planner::Mode::Subtractive, "T" + std::to_string(tool), "top", region, tool);
+  int mill(const Solid& region, int tool, const std::string& setup = "top") {
+    return add("sm-cons", planner::Mode::Subtractive, "T" + std::to_string(tool), setup, region, tool);
   }
   planner::PlanFilePlan plan(std::vector<int> actions) const {
     planner::PlanFilePlan p;
@@ -101,6 +101,18 @@ TEST(Execution, APlanThatMakesItsPartHasNoReason) {
   EXPECT_TRUE(run.proven()) << all_reasons(run);
   EXPECT_GT(run.program.lines.size(), 10u);
   EXPECT_TRUE(run.deviation.within_tolerance);
+  EXPECT_EQ(run.report.gouge, 0);
+}
+
+// The same from the bottom setup: the part turned over, the step milled from below.
+TEST(Execution, APlanMilledFromBelowMakesItsPartToo) {
+  Case c(0.5);
+  const Solid raw = c.box({{0, 0, 2}, {30, 20, 12}});
+  c.file.design = subtract(raw, c.box({{15, -5, -5}, {35, 25, 7}}));
+  const int s = c.stock(raw);
+  const int m = c.mill(c.box({{15, -5, -5}, {35, 25, 7}}), 1, "bottom");
+  const Execution run = execute_plan(c.file, c.plan({s, m}), machine());
+  EXPECT_TRUE(run.proven()) << all_reasons(run);
   EXPECT_EQ(run.report.gouge, 0);
 }
 
