@@ -227,8 +227,8 @@ class DepositionBuilder {
   // Emission state.
   bool started_ = false;
   Vec3 at_{};
-  int warnings_overhang_ = 0, warnings_blocked_ = 0, dropped_total_ = 0;
-  double overhang_area_total_ = 0, blocked_area_total_ = 0;
+  int warnings_overhang_ = 0, dropped_total_ = 0;
+  double overhang_area_total_ = 0;
 };
 
 void DepositionBuilder::run(const Solid& roi_all, const Solid& existing) {
@@ -388,10 +388,13 @@ void DepositionBuilder::drop_blocked(SliceMask& region, int k, int layer, double
   if (n == 0) return;
   region = region.without(blocked);
   const double area = double(n) * h_ * h_;
-  blocked_area_total_ += area;
-  if (++warnings_blocked_ <= kMaxWarningsPerKind)
-    path_.warnings.push_back("layer " + std::to_string(layer + 1) + " at z=" + mm(zb) + " mm: " + mm(area) +
-                             " mm^2 lie under existing material, out of reach from the approach side; skipped");
+  // The part would lack this deposit: a defect (export refuses, validation rejects).
+  const CellBox b = cell_bounds(blocked);
+  const Vec3 middle{lattice_.origin.x + 0.5 * (b.x0 + b.x1) * h_, lattice_.origin.y + 0.5 * (b.y0 + b.y1) * h_, zb};
+  path_.defects.push_back({"layer_skipped", "layer " + std::to_string(layer + 1) + " at z=" + mm(zb) + " mm: " +
+                                                mm(area) + " mm^2 lie under existing material, out of reach from "
+                                                "the approach side; skipped",
+                           middle});
 }
 
 // Overhangs: deposit with nothing (existing, deposited, plate) close enough below.
@@ -474,9 +477,6 @@ void DepositionBuilder::finish() {
   if (warnings_overhang_ > kMaxWarningsPerKind)
     path_.warnings.push_back("overhang: " + std::to_string(warnings_overhang_) + " layers in all, " +
                              mm(overhang_area_total_) + " mm^2 of deposit with nothing below it");
-  if (warnings_blocked_ > kMaxWarningsPerKind)
-    path_.warnings.push_back(std::to_string(warnings_blocked_) + " layers in all have ROI under existing material (" +
-                             mm(blocked_area_total_) + " mm^2), skipped");
   if (dropped_total_ > 0)
     path_.warnings.push_back(std::to_string(dropped_total_) + " raster segments shorter than " + mm(min_length_) +
                              " mm dropped (narrow parts of the region stay unfilled)");

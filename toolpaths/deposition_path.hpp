@@ -70,9 +70,10 @@ struct DepositionOptions {
 //   existing  material present before the action, part frame, same lattice (may be empty)
 //   head      the additive head: bead, layer_height, hatch_spacing, travel_clearance, feed
 //   setup     the setup: its approach becomes the work frame's +Z; its name is recorded
-// Moves are in mm in the work frame. Warnings: overhangs (deposit with nothing below),
-// ROI under existing material (not reachable from the approach side: skipped), dropped
-// short segments. A layer height, hatch spacing or feed left at 0 takes the machine
+// Moves are in mm in the work frame. Defects (Toolpath::defects, the part will be wrong):
+// ROI under existing material, not reachable from the approach side, is skipped
+// ("layer_skipped", one per layer). Warnings: overhangs (deposit with nothing below),
+// dropped short segments. A layer height, hatch spacing or feed left at 0 takes the machine
 // file's default (0.8 x bead height, 0.7 x bead width, 1000 mm/min). Throws
 // std::invalid_argument on solids on different lattices or a head without a bead.
 Toolpath deposition_path(const geometry::Solid& roi, const geometry::Solid& existing, const config::AdditiveHead& head,

@@ -373,7 +373,14 @@ TEST(DepositionPath, RoiUnderExistingMaterialIsSkipped) {
   const Solid roi = box({{2, 2, 1}, {18, 8, 3}});
   const auto head = ded_head();
   const Toolpath p = deposition_path(roi, existing, head, top_setup());
-  EXPECT_TRUE(has_warning(p, "under existing material"));
+  // A defect, not a warning: the part would lack that deposit (export refuses the plan).
+  EXPECT_FALSE(has_warning(p, "under existing material"));
+  ASSERT_FALSE(p.defects.empty());
+  for (const gcode::PathDefect& d : p.defects) {
+    EXPECT_EQ(d.kind, "layer_skipped");
+    EXPECT_NE(d.message.find("under existing material"), std::string::npos) << d.message;
+    EXPECT_NEAR(d.where.x, 10, 1.5) << "the middle of the bridged columns";
+  }
   for (const auto& s : deposition_segments(p))
     along(s.a, s.b, 0.05, [&](Vec3 q) { EXPECT_FALSE(q.x > 8.01 && q.x < 11.99) << q.x; });
 }
