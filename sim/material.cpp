@@ -142,6 +142,7 @@ void for_each_word(RowMask& mask, geometry::Solid& stock, bool z_descending, Fn&
 struct BeadLaying {
   geometry::Solid& stock;
   const IndexBox& domain;
+  int plate;  // the first layer above the build plate
   const instruments::SupportRule& rule;
   Tally added, overlap, fallen;
 
@@ -174,7 +175,7 @@ struct BeadLaying {
     const int bottom = mask.box.lo.z, middle = (mask.box.lo.z + mask.box.hi.z - 1) / 2;
     // The bead is one layer of the build: it looks back one layer, to what it rests on
     // and fuses with; on the plate it needs nothing.
-    const bool on_plate = bottom - 1 < domain.lo.z;
+    const bool on_plate = bottom <= plate;
     if (!on_plate)
       for (int y = gy0; y < gy1; ++y)
         for (int x = gx0; x < gx1; ++x)
@@ -227,6 +228,8 @@ MaterialSimulation::MaterialSimulation(geometry::Solid stock, std::optional<geom
                                        SimulationOptions options)
     : stock_(std::move(stock)), protected_(std::move(protected_region)), options_(options) {
   domain_ = stock_.storage_box();
+  plate_ = domain_.lo.z;
+  empty_ = stock_.empty();
   if (domain_.empty()) throw std::invalid_argument("the stock must have a non-empty storage box (the simulated domain)");
   if (protected_ && !(protected_->lattice() == stock_.lattice()))
     throw std::invalid_argument("the protected solid must share the stock's lattice");
@@ -325,7 +328,10 @@ MoveReport MaterialSimulation::deposit(const Bead& bead, const MaterialMove& mov
         }
     }
     const instruments::SupportRule rule = instruments::support_rule(bead.support, stock_.voxel_size());
-    BeadLaying laying{stock_, domain_, rule, {}, {}, {}};
+    // Nothing there yet: the program builds from a plate, whose top is where it lays its
+    // first bead (a plan that starts by depositing starts at the design's lowest layer).
+    if (empty_ && !bead_mask.empty()) plate_ = std::max(plate_, bead_mask.box.lo.z);
+    BeadLaying laying{stock_, domain_, plate_, rule, {}, {}, {}};
     // The body sits above the bead: fresh material can reach it only on a falling move.
     if (move.to.z < move.from.z) {
       laying.lay(bead_mask);
@@ -336,6 +342,7 @@ MoveReport MaterialSimulation::deposit(const Bead& bead, const MaterialMove& mov
     }
     const Tally& added = laying.added;
     const Tally& overlap = laying.overlap;
+    if (added.voxels > 0) empty_ = false;
     out.deposited = double(added.voxels) * v;
     out.overlap = double(overlap.voxels) * v;
     out.outside = double(outside.voxels) * v;

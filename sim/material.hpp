@@ -72,7 +72,8 @@ class MaterialSimulation {
  public:
   // `stock`: the material at the start. Its storage box is the simulated domain: nothing
   // exists beyond it, deposition beyond it is lost (and reported), and its lowest voxel
-  // layer stands on the build plate. `protected_region`: voxels that must not be removed
+  // layer stands on the build plate; an empty stock stands for a plate whose top is where
+  // the first bead is laid. `protected_region`: voxels that must not be removed
   // (the design grown by its tolerance), on the stock's lattice (std::invalid_argument
   // otherwise).
   explicit MaterialSimulation(geometry::Solid stock, std::optional<geometry::Solid> protected_region = std::nullopt,
@@ -102,6 +103,10 @@ class MaterialSimulation {
   SimulationOptions options_;
   geometry::IndexBox domain_;
   SimulationReport report_;
+  // The build plate lies under this layer: the domain's lowest, or, on a stock that was
+  // empty, the first bead's lowest layer (docs/support.md, "In the simulator").
+  int plate_ = 0;
+  bool empty_ = true;  // no material in the stock yet
   // Reused scratch words for one move's swept voxels (instrument, body).
   std::vector<std::uint64_t> scratch_[2];
 };
