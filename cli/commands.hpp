@@ -33,5 +33,6 @@ void add_status_command(CLI::App& app, Runner& runner);
 void add_run_command(CLI::App& app, Runner& runner);
 void add_dry_run_command(CLI::App& app, Runner& runner);
 void add_bridge_command(CLI::App& app, Runner& runner);
+void add_report_command(CLI::App& app, Runner& runner);
 
 }  // namespace hybridctl::cli

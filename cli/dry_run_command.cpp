@@ -18,6 +18,7 @@
 #include "cli/commands.hpp"
 #include "cli/memory_budget.hpp"
 #include "cli/ranges.hpp"
+#include "cli/report_job.hpp"
 #include "cli/run_job.hpp"
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
@@ -41,6 +42,7 @@ struct DryRunArgs {
   double voxel = 0;
   std::string memory_budget;
   double time_scale = 0;
+  bool report = false;
 };
 
 // `hybridctl sim serve` as a child process; killed when this goes out of scope.
@@ -189,6 +191,16 @@ int run_dry_run(const DryRunArgs& a) {
     clean += dry_run_plan(a, file, rank, out / ("plan-" + std::to_string(rank)));
   std::printf("dry-run     %d of %d plan%s ran to the end with no alarm, within tolerance both ways\n", clean, runs,
               runs == 1 ? "" : "s");
+  if (a.report) {
+    // The report shows what one run built: plan N's, or with --all the best plan's.
+    const fs::path run = out / ("plan-" + std::to_string(a.all ? 1 : a.plan));
+    report::ReportRequest request;
+    request.plan = plan_dir;
+    request.output = out / "report.html";
+    request.as_built = run / "as-built.vdb";
+    request.run_report = run / "sim-report.json";
+    write_job_report(request);
+  }
   return clean == runs ? int(kSuccess) : int(kMachineStopped);
 }
 
@@ -210,6 +222,8 @@ void add_dry_run_command(CLI::App& app, Runner& runner) {
       ->excludes(plan);
   cmd->add_option("--voxel", a->voxel, "Voxel size in mm (default: the machine file's)")->check(greater_than(0));
   add_memory_budget_option(cmd, a->memory_budget);
+  cmd->add_flag("--report", a->report,
+                "Also write the job report with what the run built and its alarms, DIR/report.html and its PNG snapshots");
   cmd->add_option("--time-scale", a->time_scale, "Simulated seconds per real second (0: as fast as possible)")
       ->capture_default_str()
       ->check(at_least(0));

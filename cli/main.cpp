@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   add_run_command(app, runner);
   add_dry_run_command(app, runner);
   add_bridge_command(app, runner);
+  add_report_command(app, runner);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -7,6 +7,7 @@
 #include "cli/ranges.hpp"
 #include "cli/export_run.hpp"
 #include "cli/progress.hpp"
+#include "cli/report_job.hpp"
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
 #include "planner/plan_report.hpp"
@@ -30,6 +31,7 @@ struct PlanArgs {
   std::vector<std::string> primitive_files;
   bool no_validate = false;
   int max_rejected = 200;
+  bool report = false;
 };
 
 planner::PrimitiveFile parse_primitive_argument(const std::string& arg) {
@@ -42,6 +44,8 @@ planner::PrimitiveFile parse_primitive_argument(const std::string& arg) {
 }
 
 int run_plan(const PlanArgs& args) {
+  if (args.report && args.output.empty() && args.export_dir.empty())
+    throw InputError("--report: the report is made from the plan directory: give -o DIR (or --export DIR)");
   const std::string machine_text = config::read_machine_text(args.machine);
   const config::Machine machine = config::parse_machine(machine_text, args.machine);
   planner::PlanningOptions options;
@@ -83,6 +87,11 @@ int run_plan(const PlanArgs& args) {
     total += seconds;
   }
   std::printf(" total %.2f s\n", total);
+  if (args.report) {  // also, and most of all, for a part that is not manufacturable
+    report::ReportRequest request;
+    request.plan = plan_dir;
+    write_job_report(request);
+  }
   if (!args.export_dir.empty() && result.verdict.manufacturable && !result.plans.empty()) {
     ExportRequest request;
     request.plan = plan_dir;
@@ -109,6 +118,8 @@ void add_plan_command(CLI::App& app, Runner& runner) {
   cmd->add_option("--export", args->export_dir,
                   "Also write the best plan's G-code into this directory (as `hybridctl export`; the plan goes to "
                   "-o, or to DIR/plan)");
+  cmd->add_flag("--report", args->report,
+                "Also write the job report, DIR/report.html and its PNG snapshots (as `hybridctl report DIR`)");
   cmd->add_option("--dialect", args->dialect, "With --export: rs274ngc or fanuc (default: the machine file's)");
   cmd->add_option("--voxel", args->voxel, "Voxel size in mm (default: the machine file's planning.voxel_size)")
       ->check(greater_than(0));

@@ -1,0 +1,85 @@
+// The job report of the bundled bracket with 5 plans on the bundled machine at its own
+// voxel size (0.5 mm): the time `hybridctl report` adds beyond the plan itself (issue 17
+// asks for at most 2 s) and the page's size, split into its parts: gathering (atoms,
+// states, toolpaths, meshes) and writing the page with its snapshots.
+//
+//   build/bench/report_bench [--voxel MM]   (plans once first; that time is not measured)
+
+#include <benchmark/benchmark.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+#include "config/machine_loader.hpp"
+#include "geometry/mesh.hpp"
+#include "planner/plan_report.hpp"
+#include "report/report.hpp"
+#include "report/report_data.hpp"
+
+namespace {
+
+using namespace hybridctl;
+namespace fs = std::filesystem;
+
+double g_voxel = 0.5;
+
+const fs::path& plan_directory() {
+  static const fs::path dir = [] {
+    const fs::path d = fs::temp_directory_path() / ("hybridctl-report-bench-" + std::to_string(::getpid()));
+    const std::string text = config::read_machine_text(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
+    const config::Machine machine = config::parse_machine(text, "hybrid-3axis.yaml");
+    planner::PlanningOptions options;
+    options.voxel_size = g_voxel;
+    options.top_k = 5;
+    const auto start = std::chrono::steady_clock::now();
+    const auto result = planner::plan_part(geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/bracket.stl"),
+                                           "bracket.stl", machine, options);
+    std::fprintf(stderr, "planned the bracket at %.2f mm: %zu plans in %.1f s\n", g_voxel, result.plans.size(),
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    planner::write_plan_directory(result, {"bracket.stl", "hybrid-3axis.yaml", machine.name, text}, d);
+    return d;
+  }();
+  return dir;
+}
+
+void BM_ReportData(benchmark::State& state) {
+  report::ReportRequest request;
+  request.plan = plan_directory();
+  std::size_t triangles = 0, segments = 0;
+  for (auto _ : state) {
+    const report::ReportData data = report::report_data(request);
+    triangles = data.triangles;
+    segments = data.segments;
+  }
+  state.counters["triangles"] = double(triangles);
+  state.counters["segments"] = double(segments);
+}
+BENCHMARK(BM_ReportData)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+void BM_WriteReport(benchmark::State& state) {
+  report::ReportRequest request;
+  request.plan = plan_directory();
+  report::ReportResult r;
+  for (auto _ : state) r = report::write_report(request);
+  state.counters["page_MB"] = double(r.bytes) / 1e6;
+  state.counters["plans"] = r.plans;
+  state.counters["actions"] = r.actions;
+  state.counters["triangles"] = double(r.triangles);
+  state.counters["segments"] = double(r.segments);
+}
+BENCHMARK(BM_WriteReport)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  for (int i = 1; i + 1 < argc; ++i)
+    if (std::strcmp(argv[i], "--voxel") == 0) g_voxel = std::atof(argv[i + 1]);
+  benchmark::Initialize(&argc, argv);
+  benchmark::RunSpecifiedBenchmarks();
+  std::error_code ec;
+  fs::remove_all(plan_directory(), ec);
+  return 0;
+}

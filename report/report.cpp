@@ -1,0 +1,110 @@
+#include "report/report.hpp"
+
+#include <algorithm>
+#include <fstream>
+
+#include "common/atomic_file.hpp"
+#include "common/error.hpp"
+#include "report/report_data.hpp"
+#include "report/report_page.hpp"
+#include "report/snapshot.hpp"
+
+namespace hybridctl::report {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The page's colours (report.js, kColours), for the snapshots to match it.
+const Colour kDesign{0.62f, 0.68f, 0.76f};
+const Colour kViolating{0.86f, 0.10f, 0.12f};
+const Colour kAdditiveState{0.93f, 0.80f, 0.64f};
+const Colour kSubtractiveState{0.74f, 0.81f, 0.90f};
+const Colour kDeposit{0.80f, 0.25f, 0.00f};
+const Colour kCut{0.00f, 0.36f, 0.72f};
+
+void grow(geometry::Box3& box, bool& any, const IndexedMesh& mesh) {
+  for (std::size_t i = 0; i + 2 < mesh.positions.size(); i += 3) {
+    const geometry::Vec3 p{mesh.positions[i], mesh.positions[i + 1], mesh.positions[i + 2]};
+    if (!any) box = {p, p};
+    any = true;
+    box.min = {std::min(box.min.x, p.x), std::min(box.min.y, p.y), std::min(box.min.z, p.z)};
+    box.max = {std::max(box.max.x, p.x), std::max(box.max.y, p.y), std::max(box.max.z, p.z)};
+  }
+}
+
+// The process moves only: at the size of a tile, rapids and links would hide the part.
+SnapshotLines path_lines(const ActionPath& path, std::vector<float>& points) {
+  for (std::size_t s = 0; s < path.kinds.size(); ++s)
+    if (path.kinds[s] == SegmentKind::Process)
+      points.insert(points.end(), path.points.begin() + std::ptrdiff_t(s * 6), path.points.begin() + std::ptrdiff_t(s * 6 + 6));
+  return {&points, {path.additive ? kDeposit : kCut}};
+}
+
+fs::path beside(const fs::path& page, const std::string& suffix) {
+  return page.parent_path() / (page.stem().string() + suffix);
+}
+
+// The plan's strip: the solid after each action with the action's deposition or cuts.
+Image plan_strip(const PlanView& plan, const geometry::Box3& bounds) {
+  std::vector<std::vector<float>> points(plan.states.size());
+  std::vector<SnapshotTile> strip;
+  for (std::size_t a = 0; a < plan.states.size(); ++a) {
+    const ActionPath* path = a < plan.paths.size() && plan.paths[a].makes_gcode ? &plan.paths[a] : nullptr;
+    SnapshotTile tile{{{&plan.states[a], !path || path->additive ? kAdditiveState : kSubtractiveState, false}}, {}};
+    if (path) tile.lines.push_back(path_lines(*path, points[a]));
+    strip.push_back(std::move(tile));
+  }
+  return render_tiles(strip, bounds, std::min<int>(int(strip.size()), 5), 360, 270);
+}
+
+std::vector<fs::path> write_snapshots(const ReportData& data, const fs::path& page) {
+  geometry::Box3 bounds;
+  bool any = false;
+  grow(bounds, any, data.design);
+  for (const PlanView& plan : data.plans)
+    for (const IndexedMesh& m : plan.states) grow(bounds, any, m);
+  for (const IndexedMesh& m : data.violating) grow(bounds, any, m);
+  if (!any) return {};
+  std::vector<fs::path> written;
+  SnapshotTile overview{{{&data.design, kDesign, false}}, {}};
+  for (const IndexedMesh& m : data.violating) overview.meshes.push_back({&m, kViolating, true});
+  written.push_back(beside(page, "-overview.png"));
+  write_png(render_tiles({overview}, bounds, 1, 960, 640), written.back());
+  for (std::size_t k = 0; k < data.plans.size(); ++k) {
+    if (data.plans[k].states.empty()) continue;
+    written.push_back(beside(page, "-plan-" + std::to_string(k + 1) + ".png"));
+    write_png(plan_strip(data.plans[k], bounds), written.back());
+  }
+  return written;
+}
+
+}  // namespace
+
+ReportResult write_report(const ReportRequest& request) {
+  const fs::path plan_dir = fs::is_directory(request.plan) ? request.plan : request.plan.parent_path();
+  ReportResult result;
+  result.page = request.output.empty() ? plan_dir / "report.html" : request.output;
+  const ReportData data = report_data(request);
+  const std::string page = report_page(data.document, request.three_js_directory);
+  if (page.size() > request.size_budget)
+    throw InputError(result.page.string() + ": the report would be " + std::to_string(page.size() >> 20) +
+                     " MiB, over its budget of " + std::to_string(request.size_budget >> 20) +
+                     " MiB: lower the triangle budgets (docs/report.md)");
+  AtomicFile file(result.page);
+  {
+    std::ofstream out(file.temp_path(), std::ios::binary);
+    out << page;
+    out.flush();
+    if (!out) throw InputError(result.page.string() + ": cannot write");
+  }
+  file.commit();
+  result.bytes = page.size();
+  result.triangles = data.triangles;
+  result.segments = data.segments;
+  result.plans = int(data.plans.size());
+  result.actions = data.actions;
+  if (request.snapshots) result.snapshots = write_snapshots(data, result.page);
+  return result;
+}
+
+}  // namespace hybridctl::report
