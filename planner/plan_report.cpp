@@ -357,14 +357,9 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
     for (std::size_t k = 0; k < r.plans.size(); ++k) {
       const Plan& plan = r.plans[k];
       const Deviation& d = r.deviations[k];
-      os << "  " << (k + 1) << ". " << expression(r.problem, plan) << "  cost " << fixed(plan.cost, 4) << "\n";
-      os << "     deviation: " << deviation_text(d, r.tolerance) << "\n";
-
       os << "  " << (k + 1) << ". " << expression(r.problem, plan) << "  cost " << fixed(plan.cost, 4) << ", "
          << optimality_text(plan, k) << "\n";
-      os << "     deviation: " << fixed(d.over_volume, 1) << " mm\u00B3 over, " << fixed(d.under_volume, 1)
-         << " mm\u00B3 under, worst " << fixed(d.worst_distance, 2) << " mm ("
-         << (d.within_tolerance ? "within" : "OUTSIDE") << " tolerance)\n";
+      os << "     deviation: " << deviation_text(d, r.tolerance) << "\n";
       for (std::size_t s = 0; s < plan.steps.size(); ++s) {
         const PlanStep& st = plan.steps[s];
         const Primitive& p = r.primitives[std::size_t(st.primitive)];
