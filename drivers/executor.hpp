@@ -37,6 +37,7 @@ struct JobRequest {
   std::string resume;     ///< job directory to resume
   unsigned from_line = 0; ///< with `resume`: restart the program there (the controller lost it)
   bool machine_override = false;  ///< with a plan: take `machine` even when it is not the plan's
+  double wait_for_controller_s = 120;  ///< a controller silent mid-stream is waited for this long (StreamOptions)
 };
 
 /// The job as it starts streaming.
