@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <climits>
+#include <limits>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -144,6 +145,8 @@ struct BeadLaying {
   const IndexBox& domain;
   int plate;  // the first layer above the build plate
   const instruments::SupportRule& rule;
+  const geometry::Lattice& lattice;
+  std::span<const Segment> axis;  // the bead's axis: the path of the programmed point, mm
   Tally added, overlap, fallen;
 
   void lay(RowMask& mask) {
@@ -187,10 +190,30 @@ struct BeadLaying {
     const instruments::Below below{1, under};
     const instruments::LayerGrid held =
         instruments::supported_cells(candidates, std::span(&below, on_plate ? 0 : 1), under, rule).held;
+    // A bead is one melt pool: where its axis is held (by the rule, or resting on material),
+    // its whole cross-section is, edges overhanging the layer below included. That is the
+    // usual criterion for DED and wire-arc beads (a bead holds while its centre is over
+    // what it is laid on and the cone's lean), and it is what makes the planner's voxel
+    // layers, whose edge beads spill half a bead beyond, agree with the simulator.
+    auto axis_held = [&](int x, int y) {
+      const geometry::Vec3 c = lattice.center({x, y, 0});
+      double best = std::numeric_limits<double>::infinity();
+      geometry::Vec3 at = c;
+      for (const Segment& s : axis) {
+        const double dx = s.to.x - s.from.x, dy = s.to.y - s.from.y, len2 = dx * dx + dy * dy;
+        const double t = len2 > 0 ? std::clamp(((c.x - s.from.x) * dx + (c.y - s.from.y) * dy) / len2, 0.0, 1.0) : 0.0;
+        const geometry::Vec3 p{s.from.x + t * dx, s.from.y + t * dy, 0};
+        const double d = (p.x - c.x) * (p.x - c.x) + (p.y - c.y) * (p.y - c.y);
+        if (d < best) best = d, at = p;
+      }
+      const int ax = int(std::floor((at.x - lattice.origin.x) / lattice.voxel_size));
+      const int ay = int(std::floor((at.y - lattice.origin.y) / lattice.voxel_size));
+      return held.filled(ax, ay) || under.filled(ax, ay);
+    };
     for (const Index3& v : fresh) {
       const int w = word_of(v.x);
       const std::uint64_t bit = std::uint64_t{1} << (v.x - w * kWordBits);
-      if (!held.filled(v.x, v.y)) {
+      if (!held.filled(v.x, v.y) && !axis_held(v.x, v.y)) {
         fallen.add(bit, w, v.y, v.z);
         continue;
       }
@@ -331,7 +354,7 @@ MoveReport MaterialSimulation::deposit(const Bead& bead, const MaterialMove& mov
     // Nothing there yet: the program builds from a plate, whose top is where it lays its
     // first bead (a plan that starts by depositing starts at the design's lowest layer).
     if (empty_ && !bead_mask.empty()) plate_ = std::max(plate_, bead_mask.box.lo.z);
-    BeadLaying laying{stock_, domain_, plate_, rule, {}, {}, {}};
+    BeadLaying laying{stock_, domain_, plate_, rule, lattice, segments, {}, {}, {}};
     // The body sits above the bead: fresh material can reach it only on a falling move.
     if (move.to.z < move.from.z) {
       laying.lay(bead_mask);
