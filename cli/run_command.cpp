@@ -178,7 +178,7 @@ int run_job(const RunRequest& request, std::vector<std::pair<std::string, std::u
     const SigintHold hold;
     result = drivers::execute_job(
         {request.input, request.machine, request.transport, request.rank, request.job, request.resume, request.from_line,
-         request.machine_override, proven_plan_program},
+         request.machine_override, proven_plan_program, request.wait_for_controller},
         op);
   }
   if (op.tty) std::fprintf(stderr, "\n");
@@ -209,6 +209,11 @@ void add_run_command(CLI::App& app, Runner& runner) {
                   "With --resume, after the controller lost the program: restart it at this line as a new program (the "
                   "line the loss message names, after checking the machine)")
       ->needs("--resume");
+  cmd->add_option("--wait-for-controller", request->wait_for_controller,
+                  "Seconds to wait for a controller that stops answering mid-program (a power cycle) before giving up "
+                  "(exit 6; --resume goes on later)")
+      ->default_val(120)
+      ->check(CLI::Range(0.0, 86400.0));
   cmd->add_flag("-y,--yes", request->yes, "Unattended: continue after program stops and clear recoverable alarms");
   cmd->callback([&runner, request] { runner = [request] { return run_job(*request); }; });
 }

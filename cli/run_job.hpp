@@ -20,6 +20,7 @@ struct RunRequest {
   std::string resume;     // job directory to resume
   unsigned from_line = 0; // with resume: restart the program there (the controller lost it)
   bool yes = false;
+  double wait_for_controller = 120;  // s: a controller silent mid-program is waited for this long
 };
 
 // Returns the exit code: kSuccess, or kMachineStopped when the machine stopped first.

@@ -250,13 +250,14 @@ StreamCallbacks stream_callbacks(JobOperator& op, ActionTracker& actions, const 
   return cb;
 }
 
-JobResult stream_job(Job& job, JobOperator& op) {
+JobResult stream_job(Job& job, JobOperator& op, double wait_for_controller_s) {
   auto transport = open_transport(job.header.transport);
   ActionTracker actions(job.program);
   const auto begun = Clock::now();
   const StreamCallbacks cb = stream_callbacks(op, actions, job.program.lines, begun);
   StreamOptions options;
   options.resume = job.resumed && !job.restarted;
+  options.controller_back_within_s = wait_for_controller_s;
   options.resume_host_hold = options.resume && job.journal->progress().held_by_host;
   JobResult result;
   result.stream = stream_program(*transport, job.program.lines, options, cb, &*job.journal);
@@ -282,7 +283,7 @@ JobResult execute_job(const JobRequest& request, JobOperator& op) {
   open_journal(request, job, identity);
   op.started({job.journal->file().parent_path().string(), job.header.program, job.program.lines.size(), identity,
               job.machine.name, job.header.transport, estimated_s});
-  return stream_job(job, op);
+  return stream_job(job, op, request.wait_for_controller_s);
 }
 
 }  // namespace hybridctl::drivers

@@ -46,6 +46,7 @@ struct JobRequest {
   std::function<gcode::PostedProgram(const planner::PlanFile&, const planner::PlanFilePlan&, const config::Machine&,
                                      const gcode::PostOptions&)>
       plan_program;
+  double wait_for_controller_s = 120;  ///< a controller silent mid-stream is waited for this long (StreamOptions)
 };
 
 /// The job as it starts streaming.

@@ -90,7 +90,12 @@ class Session {
         // the status again, and let it say what to send (a chunk that arrived comes back
         // DUPLICATE). An unreachable controller, or one failing request after another,
         // ends the stream: the journal lets `run --resume` go on later.
-        const bool transient = e.kind() != TransportError::Kind::Unreachable && e.kind() != TransportError::Kind::Unsupported;
+        if (e.kind() == TransportError::Kind::Unreachable) {
+          wait_for_controller(e);
+          reread = true;
+          continue;
+        }
+        const bool transient = e.kind() != TransportError::Kind::Unsupported;
         // Progress: chunks taken or lines executed since the last failure.
         const std::uint64_t progress = result_.counters.chunks_accepted + status_.last_executed_line;
         failures_in_row = progress != progress_at_failure ? 1 : failures_in_row + 1;
@@ -101,6 +106,36 @@ class Session {
         note(std::string("the link failed (") + e.what() + "); reading the controller's status again");
         pause.wait_after_failure();
         reread = true;
+      }
+    }
+  }
+
+  // The controller stopped answering mid-stream. A power cycle takes a while: wait for it
+  // (StreamOptions::controller_back_within_s) with a note every few seconds; the transport
+  // reconnects on its own schedule at each status read. Then the status read that
+  // succeeds decides (a new boot without our program is a loss, see seen()).
+  void wait_for_controller(const TransportError& first) {
+    const auto since_lost = Clock::now();
+    auto noted = since_lost - std::chrono::hours(1);
+    std::string last = first.what();
+    while (true) {
+      const double waited = since(since_lost);
+      if (waited >= options_.controller_back_within_s)
+        throw TransportError(TransportError::Kind::Unreachable,
+                             last + " (waited " + std::to_string(int(waited)) + " s for the controller to come back)");
+      if (since(noted) >= options_.waiting_note_period_s) {
+        noted = Clock::now();
+        note("the controller does not answer (" + last + "); waiting for it to come back, " +
+             std::to_string(int(options_.controller_back_within_s - waited)) + " s more");
+      }
+      try {
+        seen(t_.read_status());
+        note("the controller answers again after " + std::to_string(int(since(since_lost))) + " s");
+        return;
+      } catch (const TransportError& e) {
+        if (e.kind() == TransportError::Kind::Unsupported) throw;
+        last = e.what();
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));
       }
     }
   }

@@ -59,8 +59,13 @@ struct StreamOptions {
   // A request the transport gave up on (after its own resends) costs a pause (100 ms,
   // doubling up to 2 s) and a fresh status read; this many in a row with no progress in
   // between (no chunk taken, no line executed) end the stream (TransportError).
-  // Unreachable ends it at once.
   int max_failures_in_row = 5;
+  // A controller that stops answering at all once the stream is under way (a power cycle,
+  // a reboot, a pulled cable) is waited for this long, reconnecting on the transport's
+  // schedule and saying so, before the stream ends Unreachable: a controller that boots
+  // again is met at its first status (docs/drivers.md). Before the first status:
+  // Unreachable at once.
+  double controller_back_within_s = 120.0;
 };
 
 struct StreamCounters {

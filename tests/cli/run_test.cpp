@@ -442,8 +442,8 @@ std::uint32_t journal_executed(const fs::path& journal) {
 
 // A controller power cycle mid-program: the simulator killed (SIGKILL) at about line 3000
 // and a new one started on the same port, with no program and no safe point. The host
-// stops at the first status of the new controller, says what ran, what may have, and what
-// to do; `run --resume --from-line` then runs the rest once.
+// waits for it (beyond the transport's reconnect attempts), stops at the first status of
+// the new controller, says what ran, what may have, and what to do; `run --resume --from-line` then runs the rest once.
 TEST_F(Run, AControllerPowerLossStopsTheHostWhichSaysWhatRanAndResumesFromTheSafePoint) {
   std::unique_ptr<Background> first, second;
   const int port = start_sim(first, dir_, "sim1", 0, "200", plan().string());
@@ -456,6 +456,12 @@ TEST_F(Run, AControllerPowerLossStopsTheHostWhichSaysWhatRanAndResumesFromTheSaf
   ASSERT_GE(journal_executed(dir_ / "job" / "journal.jsonl"), 3000u) << slurp(dir_ / "host.err").substr(0, 2000);
   ::kill(first->pid, SIGKILL);
   first->wait_exit(5);
+  // A power cycle outlasts the transport's reconnect attempts (about 11 s): the host says
+  // it waits for the controller, and the controller comes back only after that.
+  for (int i = 0; i < 1200 && slurp(dir_ / "host.err").find("waiting for it to come back") == std::string::npos; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_NE(slurp(dir_ / "host.err").find("the controller does not answer"), std::string::npos) << slurp(dir_ / "host.err");
+  ASSERT_TRUE(host.alive()) << slurp(dir_ / "host.err").substr(0, 2000);
   ASSERT_GT(start_sim(second, dir_, "sim2", port, "0", plan().string()), 0);
   // The documented bound (docs/drivers.md): the first status read once the controller
   // answers again, at most one reconnect backoff step (2 s) after it is back.
