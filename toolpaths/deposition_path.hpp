@@ -49,7 +49,7 @@ struct DepositionOptions {
   // bottom face of the lowest voxel of the ROI and the existing material.
   std::optional<double> build_plate_z;
   // Deposit is supported when material (existing, deposited, the plate) ends at most this
-  // far (mm) below the layer's bottom. Default: the layer height.
+  // far (mm) below the layer's bottom. Default: half a voxel (the voxel layer under the bead's bottom).
   std::optional<double> support_gap;
   // Deposit within this distance (mm, sideways) of supported deposit counts as supported:
   // a bead may overhang its support by a fraction of its width; farther is not laid.
