@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "common/error.hpp"
+#include "geometry/morphology.hpp"
 
 namespace hybridctl::planner {
 
@@ -34,6 +35,12 @@ geometry::Solid start_stock(const PlanFile& file, const PlanFilePlan& plan, cons
     case config::Approach::MinusY: box.hi.y = std::min(box.hi.y, region.hi.y); break;
   }
   return geometry::Solid(file.lattice, box);
+}
+
+geometry::Solid spared_by_cuts(const PlanFile& file, const PlanFilePrimitive* action) {
+  const bool removal = action && action->mode == Mode::Subtractive;
+  const geometry::Solid kept = removal ? subtract(file.design, action->region) : file.design;
+  return geometry::erode(kept, geometry::Ball{file.tolerance});
 }
 
 }  // namespace hybridctl::planner

@@ -1,6 +1,7 @@
 #pragma once
 // What a plan starts from when it is executed (validation/, `sim serve --stock`): the raw
-// stock of its first action, or nothing, and the box the simulated machine works in.
+// stock of its first action, or nothing, and the box the simulated machine works in; and
+// what its cuts must spare (a cut into that is a gouge).
 
 #include "config/machine.hpp"
 #include "geometry/solid.hpp"
@@ -16,5 +17,13 @@ namespace hybridctl::planner {
 // plate (sim/material.hpp), and the deposition toolpath lays the first layer on that plate
 // (docs/toolpaths.md, build_plate_z). Throws InputError when that setup is not the machine's.
 geometry::Solid start_stock(const PlanFile& file, const PlanFilePlan& plan, const config::Machine& machine);
+
+// What the cuts of an action must spare: the design the action keeps, shrunk by the
+// tolerance. A removal's own region is not spared: SM-cons keeps only the tool's body clear
+// of the design, so its region takes design material on purpose, for a later deposit to
+// build again (the planner's hybrid plans: mill past the design, then deposit). Whether
+// the part as built is right is the deviation's to judge, not the gouge's. Without
+// `action`, or for an additive one, the whole design shrunk by the tolerance.
+geometry::Solid spared_by_cuts(const PlanFile& file, const PlanFilePrimitive* action = nullptr);
 
 }  // namespace hybridctl::planner

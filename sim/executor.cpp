@@ -103,6 +103,15 @@ ProgramExecutor& ProgramExecutor::operator=(ProgramExecutor&&) noexcept = defaul
 
 const gcode::ModalState& ProgramExecutor::state() const { return impl_->interp.state(); }
 
+void ProgramExecutor::set_protected_region(std::optional<Solid> protected_region) {
+  Impl& i = *impl_;
+  i.options.protected_region = std::move(protected_region);
+  if (!i.sim) return;  // enter_frame turns it into the next setup's frame
+  std::optional<Solid> guard;
+  if (i.options.protected_region) guard = turned(*i.options.protected_region, i.domain, i.frame->approach, true);
+  i.sim->set_protected_region(std::move(guard));
+}
+
 Solid ProgramExecutor::stock() const {
   Impl& i = *impl_;
   if (!i.part_stock) return Solid();

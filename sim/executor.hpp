@@ -66,6 +66,11 @@ class ProgramExecutor {
   // as it was before it.
   LineOutcome execute_line(std::string_view text, int number);
 
+  // The voxels cuts must spare from the next line on (part frame), in place of
+  // ExecutorOptions::protected_region: validation protects per action what that action
+  // keeps of the design (planner/start_stock.hpp).
+  void set_protected_region(std::optional<geometry::Solid> protected_region);
+
   const gcode::ModalState& state() const;
   // The stock now (part frame); empty solid when there is no stock.
   geometry::Solid stock() const;

@@ -249,14 +249,19 @@ std::string describe(const Incident& i) {
 
 MaterialSimulation::MaterialSimulation(geometry::Solid stock, std::optional<geometry::Solid> protected_region,
                                        SimulationOptions options)
-    : stock_(std::move(stock)), protected_(std::move(protected_region)), options_(options) {
+    : stock_(std::move(stock)), options_(options) {
   domain_ = stock_.storage_box();
   plate_ = domain_.lo.z;
   empty_ = stock_.empty();
   if (domain_.empty()) throw std::invalid_argument("the stock must have a non-empty storage box (the simulated domain)");
-  if (protected_ && !(protected_->lattice() == stock_.lattice()))
-    throw std::invalid_argument("the protected solid must share the stock's lattice");
+  set_protected_region(std::move(protected_region));
   if (!(options_.arc_tolerance >= 0)) throw std::invalid_argument("arc tolerance must be >= 0");
+}
+
+void MaterialSimulation::set_protected_region(std::optional<geometry::Solid> protected_region) {
+  if (protected_region && !(protected_region->lattice() == stock_.lattice()))
+    throw std::invalid_argument("the protected solid must share the stock's lattice");
+  protected_ = std::move(protected_region);
 }
 
 double MaterialSimulation::chord_tolerance() const {

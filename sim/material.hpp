@@ -74,7 +74,7 @@ class MaterialSimulation {
   // exists beyond it, deposition beyond it is lost (and reported), and its lowest voxel
   // layer stands on the build plate; an empty stock stands for a plate whose top is where
   // the first bead is laid. `protected_region`: voxels that must not be removed
-  // (the design grown by its tolerance), on the stock's lattice (std::invalid_argument
+  // (e.g. the design shrunk by its tolerance), on the stock's lattice (std::invalid_argument
   // otherwise).
   explicit MaterialSimulation(geometry::Solid stock, std::optional<geometry::Solid> protected_region = std::nullopt,
                               SimulationOptions options = {});
@@ -91,6 +91,9 @@ class MaterialSimulation {
 
   const geometry::Solid& stock() const { return stock_; }
   const std::optional<geometry::Solid>& protected_region() const { return protected_; }
+  // The voxels cuts must spare from the next move on (same rules as the constructor's):
+  // what a plan protects changes from action to action (planner/start_stock.hpp).
+  void set_protected_region(std::optional<geometry::Solid> protected_region);
   const SimulationReport& report() const { return report_; }
   const SimulationOptions& options() const { return options_; }
 

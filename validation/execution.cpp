@@ -4,7 +4,6 @@
 
 #include "common/error.hpp"
 #include "gcode/post.hpp"
-#include "geometry/morphology.hpp"
 #include "planner/start_stock.hpp"
 #include "sim/executor.hpp"
 
@@ -30,9 +29,13 @@ Solid on_domain(const Solid& s, const planner::PlanFile& file) {
 // carry its line numbers.
 class IncrementalRun {
  public:
-  IncrementalRun(const config::Machine& machine, const planner::PlanFile& file, Solid start,
-                 const ExecutionOptions& options)
-      : machine_(machine), file_(file), options_(options), executor_(machine, "plan", executor_options(file, start, options)) {}
+  IncrementalRun(const config::Machine& machine, const planner::PlanFile& file, const planner::PlanFilePlan& plan,
+                 Solid start, const ExecutionOptions& options)
+      : machine_(machine),
+        file_(file),
+        plan_(plan),
+        options_(options),
+        executor_(machine, "plan", executor_options(file, start, options)) {}
 
   // Programs made without feedback: executed at finish().
   void take(std::vector<gcode::ActionProgram> programs) { made_ = std::move(programs); }
@@ -89,25 +92,38 @@ class IncrementalRun {
                                                const ExecutionOptions& options) {
     sim::ExecutorOptions o;
     o.stock = std::move(start);
-    o.protected_region = geometry::erode(file.design, geometry::Ball{file.tolerance});
+    o.protected_region = planner::spared_by_cuts(file);  // the header's lines, before any action
     o.simulation = options.simulation;
     return o;
   }
   void feed(const gcode::PostedProgram& program, std::size_t up_to) {
     for (; fed_ < up_to && fed_ < program.lines.size(); ++fed_) {
+      protect_for(program.action_at(std::uint32_t(fed_ + 1)));
       const sim::LineOutcome o = executor_.execute_line(program.lines[fed_], int(fed_ + 1));
       if (o.stop != sim::Stop::None && o.stop != sim::Stop::RapidIntoMaterial) errors_.push_back(o.message);
     }
   }
 
+  // Each action's lines spare what that action keeps of the design, not the whole design:
+  // a removal may cut design material a later deposit builds again (planner/start_stock.hpp).
+  void protect_for(const gcode::ProgramAction* action) {
+    if (!action || action->number == protecting_) return;
+    protecting_ = action->number;
+    const planner::PlanFilePrimitive& p =
+        file_.primitives.at(std::size_t(plan_.actions.at(std::size_t(action->number - 1)).primitive));
+    executor_.set_protected_region(planner::spared_by_cuts(file_, &p));
+  }
+
   const config::Machine& machine_;
   const planner::PlanFile& file_;
+  const planner::PlanFilePlan& plan_;
   const ExecutionOptions& options_;
   sim::ProgramExecutor executor_;
   std::vector<gcode::ActionProgram> made_;
   std::vector<toolpaths::ExportedAction> actions_;
   gcode::PostedProgram prefix_;
   std::size_t fed_ = 0;
+  int protecting_ = 0;  // the action whose spared region the executor holds (0: none yet)
   std::vector<std::string> errors_;
 };
 
@@ -116,7 +132,7 @@ class IncrementalRun {
 Execution execute_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
                        const ExecutionOptions& options) {
   Execution out;
-  IncrementalRun run(machine, file, planner::start_stock(file, plan, machine), options);
+  IncrementalRun run(machine, file, plan, planner::start_stock(file, plan, machine), options);
   if (options.planned_against == PlannedAgainst::MaterialPresent) {
     try {
       out.exported = toolpaths::export_plan(file, plan, machine, options.export_options,

@@ -70,8 +70,10 @@ struct Execution {
 };
 
 // Exports and executes `plan` of `file` on `machine` from its raw stock (an empty stock on
-// the plan's domain when it starts with deposition). The design shrunk by the tolerance is
-// protected (a cut into it is a gouge), as `sim serve --stock` protects it. Throws
+// the plan's domain when it starts with deposition). Each action's lines spare what the
+// action keeps of the design, shrunk by the tolerance (planner::spared_by_cuts; a cut into
+// it is a gouge): a removal's own region may take design material a later deposit builds
+// again, and the deviation judges the part as built. Throws
 // InputError when an action cannot be written for the machine (another machine, an
 // instrument it lacks, a move beyond its envelope), as toolpaths::export_plan and
 // gcode::post_program do.

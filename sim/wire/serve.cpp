@@ -110,7 +110,9 @@ std::string stock_from_plan(const ServeOptions& o, const config::Machine& machin
   } else {
     described = "empty (plan " + std::to_string(o.plan) + " starts with deposition)";
   }
-  options.protected_region = geometry::erode(file.design, geometry::Ball{file.tolerance});
+  // The whole design shrunk by the tolerance: the controller does not follow which action
+  // a line belongs to, so a removal the plan refills later (SM-cons) counts as gouge here.
+  options.protected_region = planner::spared_by_cuts(file);
   return described;
 }
 

@@ -15,6 +15,7 @@
 #include "geometry/mesh.hpp"
 #include "geometry/morphology.hpp"
 #include "planner/plan_report.hpp"
+#include "planner/start_stock.hpp"
 #include "sim/replay.hpp"
 
 namespace hybridctl::sim {
@@ -57,14 +58,14 @@ std::vector<ActionFigures> replay_plan(int rank) {
   const Planned& p = planned();
   const planner::PlanFilePlan& plan = p.file.plans[std::size_t(rank - 1)];
   const toolpaths::PlanExport exported = toolpaths::export_plan(p.file, plan, p.machine);
-  const Solid core = geometry::erode(p.file.design, geometry::Ball{p.file.tolerance});
   const double h = p.file.lattice.voxel_size;
   std::vector<ActionFigures> out;
   for (const toolpaths::ExportedAction& a : exported.actions) {
     if (!a.makes_gcode) continue;
     const std::string text = gcode::write_action(a.program, p.machine);
     ReplayOptions options;
-    options.protected_region = core;
+    options.protected_region =
+        planner::spared_by_cuts(p.file, &p.file.primitives.at(std::size_t(plan.actions.at(std::size_t(a.step - 1)).primitive)));
     const ReplayResult r = replay_program(text, p.machine, a.before, options, a.primitive + ".ngc");
     ActionFigures f;
     f.roi = a.roi.volume();
