@@ -201,7 +201,6 @@ class DepositionBuilder {
   SliceMask layer_region(double zb, int& k) const;
   void drop_blocked(SliceMask& region, int k, int layer, double zb);
   void drop_overhangs(SliceMask& region, int layer, double zb);
-  void lay_footprint(Vec2 a, Vec2 b, double top);
   std::vector<Pass> passes_of(const SliceMask& region, int layer, double angle);
   void finish();
 
@@ -465,8 +464,7 @@ void DepositionBuilder::deposit_layer(int layer, double zb) {
 
   const double angle = angles_[std::size_t(layer) % angles_.size()];
   bool first_of_layer = true;
-  const std::vector<Pass> passes = passes_of(region, layer, angle);
-  for (const Pass& p : passes) {
+  for (const Pass& p : passes_of(region, layer, angle)) {
     travel_to(p.points.front(), zb);
     for (std::size_t i = 1; i < p.points.size(); ++i) {
       std::string comment;
@@ -475,27 +473,10 @@ void DepositionBuilder::deposit_layer(int layer, double zb) {
       move(MoveKind::Feed, {p.points[i].x, p.points[i].y, zb}, head_.feed, true, std::move(comment));
     }
   }
-  // The layer is down: layer_height of material under its beads' footprints (half a bead
-  // either side of each pass). Region cells no bead covered (a segment too short to lay,
-  // an end held back by the inset) hold nothing: the next layer must not stand on them.
-  for (const Pass& p : passes)
-    for (std::size_t i = 1; i < p.points.size(); ++i) lay_footprint(p.points[i - 1], p.points[i], zb + lh_);
-}
-
-void DepositionBuilder::lay_footprint(Vec2 a, Vec2 b, double top) {
-  const double r = w_ / 2;
-  const int x0 = std::max(window_.lo.x, int(std::floor((std::min(a.x, b.x) - r - lattice_.origin.x) / h_)));
-  const int x1 = std::min(window_.hi.x - 1, int(std::floor((std::max(a.x, b.x) + r - lattice_.origin.x) / h_)));
-  const int y0 = std::max(window_.lo.y, int(std::floor((std::min(a.y, b.y) - r - lattice_.origin.y) / h_)));
-  const int y1 = std::min(window_.hi.y - 1, int(std::floor((std::max(a.y, b.y) + r - lattice_.origin.y) / h_)));
-  const double dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
-  for (int y = y0; y <= y1; ++y)
-    for (int x = x0; x <= x1; ++x) {
-      const double cx = lattice_.origin.x + (x + 0.5) * h_, cy = lattice_.origin.y + (y + 0.5) * h_;
-      const double t = len2 > 0 ? std::clamp(((cx - a.x) * dx + (cy - a.y) * dy) / len2, 0.0, 1.0) : 0.0;
-      const double ex = a.x + t * dx - cx, ey = a.y + t * dy - cy;
-      if (ex * ex + ey * ey <= r * r) deposited_top_.ref(x, y) = std::max(deposited_top_.at(x, y), top);
-    }
+  // The layer is down: layer_height of material on its region.
+  for (int y = window_.lo.y; y < window_.hi.y; ++y)
+    for (int x = window_.lo.x; x < window_.hi.x; ++x)
+      if (region.at(x, y)) deposited_top_.ref(x, y) = std::max(deposited_top_.at(x, y), zb + lh_);
 }
 
 // Up and clear of the part, and the summaries of the warnings.

@@ -139,7 +139,7 @@ TEST(DepositionPath, SegmentsLieInTheirLayersRegion) {
   const auto head = ded_head();
   const Toolpath p = deposition_path(roi, base, head, top_setup());
   expect_segments_in_region(p, roi, head.layer_height);
-  EXPECT_FALSE(has_warning(p, "overhang"));
+  EXPECT_FALSE(has_warning(p, "overhang")) << (p.warnings.empty() ? "" : p.warnings.front());
 }
 
 TEST(DepositionPath, ContourPassesStayInTheRegionToo) {
