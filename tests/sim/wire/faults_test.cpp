@@ -308,8 +308,13 @@ TEST(SimServe, ABeadOverAirIsAWarningOnTheWireAndTheProgramGoesOn) {
 
 TEST(SimServe, TakesTheStockFromAPlan) {
   const fs::path dir = temp_dir("plan-stock");
-  const PeerResult plan = run_peer({HYBRIDCTL_EXE, "plan", std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/bracket.stl",
-                                    "--machine", example_machine(), "--voxel", "1", "-o", (dir / "plan").string()});
+  // --no-validate: the subject is the stock `sim serve --stock` takes from a plan's first
+  // action, not whether the plan makes the part. The flanged hub's plans that pass
+  // execution all start from a raw stock; unvalidated, its 6th plan at 1 mm deposits from
+  // nothing.
+  const PeerResult plan = run_peer({HYBRIDCTL_EXE, "plan", std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/flanged-hub.stl",
+                                    "--machine", example_machine(), "--voxel", "1", "--top", "6", "--no-validate", "-o",
+                                    (dir / "plan").string()});
   ASSERT_EQ(plan.exit_code, 0) << plan.output;
   // The ranks of a plan that starts from a raw stock and of one that starts by depositing.
   const json plans = read_json(dir / "plan" / "plan.json");
@@ -321,7 +326,8 @@ TEST(SimServe, TakesTheStockFromAPlan) {
     int& rank = raw ? from_stock : from_nothing;
     if (rank == 0) rank = p["rank"];
   }
-  ASSERT_GT(from_stock, 0) << "the bracket's plans should include one from a raw stock";
+  ASSERT_GT(from_stock, 0) << "the flanged hub's plans should include one from a raw stock";
+  ASSERT_GT(from_nothing, 0) << "the flanged hub's plans should include one that starts by depositing";
   const geometry::Solid design = geometry::read_vdb(dir / "plan" / "design.vdb");
 
   auto serve_plan = [&](int rank, json& report, geometry::Solid& built) {
@@ -337,11 +343,9 @@ TEST(SimServe, TakesTheStockFromAPlan) {
   EXPECT_EQ(report["stock"].get<std::string>().rfind("raw stock ", 0), 0u) << report["stock"];
   EXPECT_GT(built.volume(), design.volume()) << "the raw stock holds the part";
   EXPECT_NEAR(report["volumes_mm3"]["as_built"].get<double>(), built.volume(), 1e-6);
-  if (from_nothing > 0) {
-    serve_plan(from_nothing, report, built);
-    EXPECT_EQ(report["stock"].get<std::string>().rfind("empty", 0), 0u) << report["stock"];
-    EXPECT_EQ(built.volume(), 0.0) << "a plan that starts by depositing starts from nothing";
-  }
+  serve_plan(from_nothing, report, built);
+  EXPECT_EQ(report["stock"].get<std::string>().rfind("empty", 0), 0u) << report["stock"];
+  EXPECT_EQ(built.volume(), 0.0) << "a plan that starts by depositing starts from nothing";
   fs::remove_all(dir);
 }
 
