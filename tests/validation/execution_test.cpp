@@ -227,9 +227,7 @@ TEST(Execution, HeadTravelIsPlannedAgainstTheMaterialTheMillingReallyLeft) {
 }
 
 // A strip deposited at the foot of a 20 mm wall: the 20 mm nozzle runs into the wall.
-// Disabled until the simulator models the nozzle body (instruments::bead_of gives none
-// yet; the physics work adds it with its NozzleCollision alarm): enable it then.
-TEST(Execution, DISABLED_TheNozzleBodyTouchingMaterialIsACollision) {
+TEST(Execution, TheNozzleBodyTouchingMaterialIsACollision) {
   Case c(1.0);
   const Solid wall = c.box({{0, 0, 0}, {5, 20, 20}});
   const Solid strip = c.box({{5, 2, 0}, {7, 18, 2}});
@@ -242,21 +240,24 @@ TEST(Execution, DISABLED_TheNozzleBodyTouchingMaterialIsACollision) {
   EXPECT_TRUE(collision) << all_reasons(run);
 }
 
-// A step milled from a raw stock (action 2, as the design wants), then a pocket milled
-// into the design (action 3): the gouge is located by its line in the whole plan's
-// program, after every line of action 2, not by a line counted from its action's start.
+// A step milled from a raw stock (action 2, as the design wants), then a strip deposited at
+// the foot of the 25 mm wall the step leaves (action 3): the nozzle runs into the wall, and
+// that is located by its line in the whole plan's program, after every line of action 2,
+// not by a line counted from its action's start.
 TEST(Execution, TheLinesAreThoseOfTheWholePlansProgram) {
   Case c(1.0);
-  const Solid raw = c.box({{0, 0, 0}, {30, 20, 10}}), step = c.box({{15, -5, 5}, {35, 25, 15}});
-  c.file.design = subtract(raw, step);
+  const Solid raw = c.box({{0, 0, 0}, {30, 20, 25}}), step = c.box({{15, -5, 5}, {35, 25, 30}});
+  const Solid strip = c.box({{15, 2, 5}, {17, 18, 7}});
+  c.file.design = unite(subtract(raw, step), strip);
   const int s = c.stock(raw);
   const int m = c.mill(step, 1);
-  const int pocket = c.mill(c.box({{1, 2, 5}, {14, 18, 15}}), 1);
-  const planner::PlanFilePlan plan = c.plan({s, m, pocket});
+  const int d = c.deposit(strip);
+  const planner::PlanFilePlan plan = c.plan({s, m, d});
   const Execution run = execute_plan(c.file, plan, machine());
   const gcode::PostedProgram whole = gcode::post_program(run.exported.programs(), machine());
   EXPECT_EQ(run.program.lines, whole.lines);
-  const planner::RejectionReason* r = first_of(run, "gouge");
+  const planner::RejectionReason* r = first_of(run, "nozzle_collision");
+  if (!r) r = first_of(run, "body_collision");
   ASSERT_NE(r, nullptr) << all_reasons(run);
   EXPECT_EQ(r->action, 3);
   const gcode::ProgramAction* a = whole.action_at(std::uint32_t(r->line));
