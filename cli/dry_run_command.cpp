@@ -1,6 +1,7 @@
-// hybridctl dry-run: plan a part, export the best plan, run it through a simulated
-// controller (a separate `hybridctl sim serve` process on loopback, over Modbus TCP or
-// socketcand), and compare what it built with what was planned.
+// hybridctl dry-run: plan a part (every plan offered proven by execution), run the best
+// plan, plan N or every plan through a simulated controller of its own (a separate
+// `hybridctl sim serve` process on loopback, over Modbus TCP or socketcand) from the raw
+// stock, and compare what it built with what was planned and with the design.
 
 #include <fcntl.h>
 #include <signal.h>
@@ -27,6 +28,7 @@
 #include "planner/plan_file.hpp"
 #include "planner/deviation.hpp"
 #include "planner/plan_report.hpp"
+#include "validation/plan_validator.hpp"
 
 namespace hybridctl::cli {
 namespace {
@@ -35,6 +37,8 @@ namespace fs = std::filesystem;
 
 struct DryRunArgs {
   std::string part, machine, output = "out/dry-run", transport = "modbus";
+  int plan = 1;
+  bool all = false;
   double voxel = 0;
   std::string memory_budget;
   double time_scale = 0;
@@ -97,30 +101,21 @@ class Simulator {
   FILE* stdout_ = nullptr;
 };
 
-int run_dry_run(const DryRunArgs& a) {
-  if (a.transport != "modbus" && a.transport != "can")
-    throw InputError("--transport " + a.transport + ": expected modbus or can");
-  const std::string machine_text = config::read_machine_text(a.machine);
-  const config::Machine machine = config::parse_machine(machine_text, a.machine);
-  const fs::path out = a.output;
+// One offered plan run through a fresh simulated controller from the plan's raw stock, in
+// OUT/plan-N; prints as built against as planned and against the design, both ways, and
+// every alarm with its line. Returns true when it ran to the end with no alarm and within
+// the tolerance.
+bool dry_run_plan(const DryRunArgs& a, const planner::PlanFile& file, int rank, const fs::path& out) {
+  const fs::path plan_json = file.directory / "plan.json";
+  const planner::PlanFilePlan& plan = file.plans[std::size_t(rank - 1)];
+  std::printf("plan %-6d %s  cost %.4f\n", rank, plan.expression.c_str(), plan.cost);
   fs::create_directories(out);
-
-  // 1. Plan.
-  planner::PlanningOptions options;
-  options.voxel_size = a.voxel;
-  options.memory_budget = memory_budget(a.memory_budget);
-  const planner::PlanningResult planned = planner::plan_part(geometry::read_stl(a.part), a.part, machine, options);
-  const planner::ReportSources sources{a.part, a.machine, machine.name, machine_text};
-  std::fputs(planner::plan_summary(planned, sources).c_str(), stdout);
-  if (!planned.verdict.manufacturable || planned.plans.empty()) return kNotManufacturable;
-  const fs::path plan_dir = out / "plan";
-  planner::write_plan_directory(planned, sources, plan_dir);
-
-  // 2. A simulated controller on loopback, starting from the plan's raw stock.
+  // 1. A simulated controller on loopback, starting from the plan's raw stock.
   const fs::path report = out / "sim-report.json", as_built = out / "as-built.vdb", lines_log = out / "executed-lines.ngc";
-  std::vector<std::string> args = {"hybridctl", "sim", "serve", "--machine", a.machine, "--stock", (plan_dir / "plan.json").string(),
-                                   "--time-scale", std::to_string(a.time_scale), "--exit-when-done", "--report",
-                                   report.string(), "--as-built", as_built.string(), "--line-log", lines_log.string()};
+  std::vector<std::string> args = {"hybridctl", "sim", "serve", "--machine", a.machine, "--stock", plan_json.string(),
+                                   "--plan", std::to_string(rank), "--time-scale", std::to_string(a.time_scale),
+                                   "--exit-when-done", "--report", report.string(), "--as-built", as_built.string(),
+                                   "--line-log", lines_log.string()};
   if (a.transport == "modbus") {
     args.insert(args.end(), {"--modbus", "tcp://127.0.0.1:0"});
   } else {
@@ -132,21 +127,26 @@ int run_dry_run(const DryRunArgs& a) {
                                                   : "socketcand://127.0.0.1:" + std::to_string(port) + "/can0";
   std::printf("simulator   %s (log %s)\n", uri.c_str(), (out / "sim.log").c_str());
 
-  // 3. Run the best plan through it, unattended.
+  // 2. The plan through it, unattended.
   fs::remove_all(out / "job");
   RunRequest run;
-  run.input = (plan_dir / "plan.json").string();
+  run.input = plan_json.string();
   run.transport = uri;
+  run.rank = rank;
   run.job = (out / "job").string();
   run.yes = true;
-  const int code = run_job(run);
-  const int sim_code = sim.wait();
-  if (code != kSuccess) return code;
-  if (sim_code != 0) throw std::runtime_error("the simulator exited with " + std::to_string(sim_code));
+  std::vector<std::pair<std::string, std::uint32_t>> alarms;
+  const int code = run_job(run, &alarms);
+  const int sim_code = code == kSuccess ? sim.wait() : 0;
+  if (code == kSuccess && sim_code != 0) throw std::runtime_error("the simulator exited with " + std::to_string(sim_code));
+  for (const auto& [name, line] : alarms) std::printf("alarm       %s at line %u\n", name.c_str(), unsigned(line));
+  if (code != kSuccess) {
+    std::printf("result      plan %d STOPPED before its end (exit %d)\n", rank, code);
+    return false;
+  }
 
-  // 4. As built versus as planned.
-  const planner::PlanFile file = planner::to_plan_file(planned, sources, plan_dir);
-  const geometry::Solid planned_shape = planner::plan_states(file, file.plans[0]).back();
+  // 3. As built versus as planned and versus the design.
+  const geometry::Solid planned_shape = planner::plan_states(file, plan).back();
   const geometry::Solid built = geometry::read_vdb(as_built);
   geometry::Solid built_here(file.lattice, file.domain);
   built.for_each_voxel([&](geometry::Index3 v) {
@@ -157,16 +157,51 @@ int run_dry_run(const DryRunArgs& a) {
   std::printf("as built    %.1f mm³ (planned %.1f mm³): %.1f mm³ beyond the plan, %.1f mm³ of it missing\n",
               built_here.volume(), planned_shape.volume(), extra.volume(), missing.volume());
   std::printf("vs design   %s\n", planner::deviation_text(d, file.tolerance).c_str());
-  std::printf("wrote       %s: plan/, job/, as-built.vdb, sim-report.json, executed-lines.ngc\n", out.c_str());
+  std::printf("wrote       %s: job/, as-built.vdb, sim-report.json, executed-lines.ngc\n", out.c_str());
+  return d.within_tolerance && alarms.empty();
+}
+
+int run_dry_run(const DryRunArgs& a) {
+  if (a.transport != "modbus" && a.transport != "can")
+    throw InputError("--transport " + a.transport + ": expected modbus or can");
+  const std::string machine_text = config::read_machine_text(a.machine);
+  const config::Machine machine = config::parse_machine(machine_text, a.machine);
+  const fs::path out = a.output;
+  fs::create_directories(out);
+
+  // 1. Plan: every plan offered is proven by execution first (validation/).
+  planner::PlanningOptions options;
+  options.voxel_size = a.voxel;
+  options.memory_budget = memory_budget(a.memory_budget);
+  options.validate = validation::plan_validator(machine);
+  const planner::PlanningResult planned = planner::plan_part(geometry::read_stl(a.part), a.part, machine, options);
+  const planner::ReportSources sources{a.part, a.machine, machine.name, machine_text};
+  std::fputs(planner::plan_summary(planned, sources).c_str(), stdout);
+  if (!planned.verdict.manufacturable || planned.plans.empty()) return kNotManufacturable;
+  const fs::path plan_dir = out / "plan";
+  planner::write_plan_directory(planned, sources, plan_dir);
+  const planner::PlanFile file = planner::to_plan_file(planned, sources, plan_dir);
+  const int plans = int(file.plans.size());
+  if (!a.all && (a.plan < 1 || a.plan > plans))
+    throw InputError("--plan " + std::to_string(a.plan) + ": expected 1.." + std::to_string(plans) + " (the plans offered)");
+
+  // 2. Each chosen plan on its own simulated controller.
+  int clean = 0, runs = 0;
+  for (int rank = a.all ? 1 : a.plan; rank <= (a.all ? plans : a.plan); ++rank, ++runs)
+    clean += dry_run_plan(a, file, rank, out / ("plan-" + std::to_string(rank)));
+  std::printf("dry-run     %d of %d plan%s ran to the end with no alarm, within tolerance both ways\n", clean, runs,
+              runs == 1 ? "" : "s");
   if (a.report) {
+    // The report shows what one run built: plan N's, or with --all the best plan's.
+    const fs::path run = out / ("plan-" + std::to_string(a.all ? 1 : a.plan));
     report::ReportRequest request;
     request.plan = plan_dir;
     request.output = out / "report.html";
-    request.as_built = as_built;
-    request.run_report = report;
+    request.as_built = run / "as-built.vdb";
+    request.run_report = run / "sim-report.json";
     write_job_report(request);
   }
-  return kSuccess;
+  return clean == runs ? int(kSuccess) : int(kMachineStopped);
 }
 
 }  // namespace
@@ -174,12 +209,17 @@ int run_dry_run(const DryRunArgs& a) {
 void add_dry_run_command(CLI::App& app, Runner& runner) {
   auto a = std::make_shared<DryRunArgs>();
   auto* cmd = app.add_subcommand("dry-run",
-                                 "Plan a part, export the best plan, run it through a simulated controller (a separate "
-                                 "`hybridctl sim serve` process on 127.0.0.1) and compare as built with as planned");
+                                 "Plan a part, export the best plan (or --plan N, or --all), run each through its own "
+                                 "simulated controller (a separate `hybridctl sim serve` process on 127.0.0.1) from the raw "
+                                 "stock and compare as built with as planned and with the design, both ways, with every "
+                                 "alarm and its line (exit 5 when a plan stopped, raised an alarm or came out of tolerance)");
   cmd->add_option("PART", a->part, "Part mesh (closed STL, mm)")->required();
   cmd->add_option("-m,--machine", a->machine, "Machine description (YAML)")->required();
   cmd->add_option("--transport", a->transport, "modbus (Modbus TCP) or can (socketcand)")->capture_default_str();
   cmd->add_option("-o,--output", a->output, "Directory for the plan, the job and the simulator's output")->capture_default_str();
+  auto* plan = cmd->add_option("--plan", a->plan, "Which offered plan to run, by rank")->capture_default_str()->check(greater_than(0));
+  cmd->add_flag("--all", a->all, "Run every offered plan, each on its own simulated controller from the raw stock")
+      ->excludes(plan);
   cmd->add_option("--voxel", a->voxel, "Voxel size in mm (default: the machine file's)")->check(greater_than(0));
   add_memory_budget_option(cmd, a->memory_budget);
   cmd->add_flag("--report", a->report,

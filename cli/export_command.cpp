@@ -14,6 +14,7 @@
 #include "gcode/files.hpp"
 #include "toolpaths/plan_export.hpp"
 #include "gcode/tool_table.hpp"
+#include "validation/execution.hpp"
 
 namespace hybridctl::cli {
 
@@ -47,7 +48,13 @@ int export_plan_programs(const planner::PlanFile& file, const ExportRequest& req
   options.post.program_name = name + " " + plan.expression;
   ProgressBar bar("toolpaths");
   options.progress = [&](int action, int actions) { bar.update(double(action - 1) / double(actions)); };
-  const toolpaths::PlanExport exported = toolpaths::export_plan(file, plan, machine, options);
+  // Each action's toolpath is planned against the material the ones before it really
+  // leave, and the program is executed from the raw stock before anything is written.
+  validation::ExecutionOptions execution;
+  execution.export_options = options;
+  const validation::Execution run = validation::require_proven(
+      file, plan, machine, execution, "plan " + std::to_string(request.rank) + " (" + plan.expression + ")");
+  const toolpaths::PlanExport& exported = run.exported;
   bar.finish();
 
   const std::vector<gcode::ActionProgram> programs = exported.programs();
@@ -71,6 +78,13 @@ int export_plan_programs(const planner::PlanFile& file, const ExportRequest& req
                 gcode::format_duration(report.time.total).c_str(), path.filename().string().c_str());
     for (const std::string& w : a.program.path.warnings) std::printf("       warning: %s\n", w.c_str());
   }
+  const planner::Deviation& d = run.deviation;
+  std::printf("executed    from the raw stock: %zu lines; as built %.1f mm³ over, %.1f mm³ under the design, worst "
+              "%.2f mm (tolerance %.2f mm, %s)\n",
+              run.program.lines.size(), d.over_volume, d.under_volume, d.worst_distance, file.tolerance,
+              d.within_tolerance ? "within" : "OUTSIDE");
+  for (const planner::RejectionReason& r : run.reasons)
+    std::printf("  warning: %s: %s\n", r.kind.c_str(), planner::describe(r).c_str());
   std::printf("wrote       %s, %zu action programs and tool.tbl in %s\n", written.program.filename().string().c_str(),
               written.actions.size(), request.output.c_str());
   return kSuccess;
@@ -80,7 +94,11 @@ void add_export_command(CLI::App& app, Runner& runner) {
   auto request = std::make_shared<ExportRequest>();
   auto* cmd = app.add_subcommand("export",
                                  "Turn a plan's actions into G-code: raster deposition and pocket milling per action, "
-                                 "one program per action plus one for the whole plan, and a LinuxCNC tool table");
+                                 "one program per action plus one for the whole plan, and a LinuxCNC tool table; "
+                                 "each action planned against the material the ones before it leave, the program "
+                                 "executed on the simulated machine from the raw stock first (exit 4 and nothing "
+                                 "written on a skipped layer, an unreachable region, a rapid or body into material, a "
+                                 "gouge or a refused line)");
   cmd->add_option("PLAN", request->plan, "plan.json (or its directory) written by `hybridctl plan -o`")->required();
   cmd->add_option("-o,--output", request->output, "Directory for the programs (created if missing)")->required();
   cmd->add_option("--plan", request->rank, "Which plan, by rank (1 = cheapest)")->default_val(1)->check(greater_than(0));

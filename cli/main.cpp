@@ -7,6 +7,7 @@
 #include "cli/ranges.hpp"
 #include "common/error.hpp"
 #include "drivers/transport.hpp"
+#include "validation/execution.hpp"
 
 int main(int argc, char** argv) {
   using namespace hybridctl::cli;
@@ -41,6 +42,10 @@ int main(int argc, char** argv) {
   }
   try {
     return runner ? runner() : kUsage;
+  } catch (const hybridctl::validation::NotManufacturableError& e) {
+    std::fflush(stdout);
+    std::fprintf(stderr, "hybridctl: not manufacturable: %s\n", e.what());
+    return kNotManufacturable;
   } catch (const hybridctl::InputError& e) {
     std::fflush(stdout);  // what was printed so far comes before the error
     std::fprintf(stderr, "hybridctl: error: %s\n", e.what());

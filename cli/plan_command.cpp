@@ -11,6 +11,7 @@
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
 #include "planner/plan_report.hpp"
+#include "validation/plan_validator.hpp"
 
 namespace hybridctl::cli {
 namespace {
@@ -28,6 +29,8 @@ struct PlanArgs {
   int reuse = 1;
   double search_time = 0;
   std::vector<std::string> primitive_files;
+  bool no_validate = false;
+  int max_rejected = 200;
   bool report = false;
 };
 
@@ -53,6 +56,9 @@ int run_plan(const PlanArgs& args) {
   options.max_uses = args.reuse;
   options.search_time = args.search_time;
   for (const std::string& p : args.primitive_files) options.extra_primitives.push_back(parse_primitive_argument(p));
+  // Every plan offered is proven by execution first (validation/, docs/validation.md).
+  if (!args.no_validate) options.validate = validation::plan_validator(machine);
+  options.max_rejected = args.max_rejected;
   ProgressBar bar("planning");
   std::string current;
   options.progress = [&](const std::string& phase, double f) {
@@ -103,7 +109,8 @@ void add_plan_command(CLI::App& app, Runner& runner) {
   auto args = std::make_shared<PlanArgs>();
   auto* cmd = app.add_subcommand("plan",
                                  "Find cost-optimal hybrid plans for a part on a machine: primitives, atoms, "
-                                 "manufacturability verdict and the k best plans (exit 4 when not manufacturable)");
+                                 "manufacturability verdict and the k best plans, each proven by execution on the simulated machine "
+                                 "(candidates that fail are rejected with their reasons; exit 4 when none is left)");
   cmd->add_option("PART", args->part, "Part mesh (closed STL, mm)")->required();
   cmd->add_option("-m,--machine", args->machine, "Machine description (YAML)")->required();
   cmd->add_option("-o,--output", args->output,
@@ -131,6 +138,13 @@ void add_plan_command(CLI::App& app, Runner& runner) {
       ->check(greater_than(0));
   cmd->add_option("--primitive", args->primitive_files,
                   "Extra primitive FILE:am or FILE:sm (STL, or .vdb on the plan's voxel grid); repeatable");
+  cmd->add_flag("--no-validate", args->no_validate,
+                "Offer the plans the search finds without executing them first (for comparison and benchmarks; "
+                "export and run still refuse a plan that does not make the part)");
+  cmd->add_option("--max-rejected", args->max_rejected,
+                  "How many candidate plans validation may turn down before the search gives up")
+      ->capture_default_str()
+      ->check(between(1, 1000));
   cmd->callback([&runner, args] { runner = [args] { return run_plan(*args); }; });
 }
 

@@ -16,6 +16,7 @@
 #include "cli/run_job.hpp"
 #include "drivers/executor.hpp"
 #include "gcode/check.hpp"
+#include "validation/execution.hpp"
 
 namespace hybridctl::cli {
 namespace {
@@ -107,8 +108,8 @@ class TerminalOperator : public drivers::JobOperator {
 
   bool clear_alarm(const protocol::Status& s) override {
     const auto& info = protocol::alarm_info(s.alarm);
-    std::fprintf(stderr, "%salarm %s: %s\n  what to do: %s\n", tty ? "\n" : "", std::string(info.name).c_str(),
-                 std::string(info.meaning).c_str(), std::string(info.action).c_str());
+    std::fprintf(stderr, "%salarm %s at line %u: %s\n  what to do: %s\n", tty ? "\n" : "", std::string(info.name).c_str(),
+                 unsigned(s.alarm_line), std::string(info.meaning).c_str(), std::string(info.action).c_str());
     if (yes_) return true;
     return ask("Clear the alarm and resume");
   }
@@ -148,28 +149,41 @@ void print_report(const drivers::JobResult& job) {
   const drivers::StreamCounters& c = r.counters;
   const drivers::TransportCounters& tc = job.transport;
   std::printf("counters    chunks %llu sent, %llu accepted, %llu duplicates, %llu refused; %llu reboots seen, %llu alarms "
-              "cleared, %llu link failures recovered; transport %llu requests, %llu timeouts, %llu retries, %llu reconnects, "
+              "cleared, %llu warnings, %llu link failures recovered; transport %llu requests, %llu timeouts, %llu retries, %llu reconnects, "
               "%llu bad replies\n",
               (unsigned long long)c.chunks_sent, (unsigned long long)c.chunks_accepted, (unsigned long long)c.duplicates,
               (unsigned long long)c.refused, (unsigned long long)c.reboots_seen, (unsigned long long)c.recoveries,
-              (unsigned long long)c.transport_errors, (unsigned long long)tc.requests, (unsigned long long)tc.timeouts,
+              (unsigned long long)c.warnings, (unsigned long long)c.transport_errors, (unsigned long long)tc.requests, (unsigned long long)tc.timeouts,
               (unsigned long long)tc.retries, (unsigned long long)tc.reconnects, (unsigned long long)tc.bad_replies);
+}
+
+// A plan's program as export writes it: each action planned against the material the
+// ones before it leave, executed on the simulated machine from the raw stock first; a plan
+// that does not make the part is refused (exit 4) before anything is streamed.
+gcode::PostedProgram proven_plan_program(const planner::PlanFile& file, const planner::PlanFilePlan& plan,
+                                         const config::Machine& machine, const gcode::PostOptions& post) {
+  validation::ExecutionOptions options;
+  options.export_options.post = post;
+  return validation::require_proven(file, plan, machine, options, "plan " + std::to_string(plan.rank) + " (" +
+                                                                      plan.expression + ")")
+      .program;
 }
 
 }  // namespace
 
-int run_job(const RunRequest& request) {
+int run_job(const RunRequest& request, std::vector<std::pair<std::string, std::uint32_t>>* alarms) {
   TerminalOperator op(request.yes);
   drivers::JobResult result;
   {
     const SigintHold hold;
     result = drivers::execute_job(
         {request.input, request.machine, request.transport, request.rank, request.job, request.resume, request.from_line,
-         request.machine_override, request.wait_for_controller},
+         request.machine_override, proven_plan_program, request.wait_for_controller},
         op);
   }
   if (op.tty) std::fprintf(stderr, "\n");
   print_report(result);
+  if (alarms) *alarms = result.alarms;
   return result.stream.completed ? int(kSuccess) : int(kMachineStopped);
 }
 

@@ -3,7 +3,10 @@
 // (drivers/executor.hpp) with its status line, prompts (--yes answers them), Ctrl-C as a
 // feed hold, and the final report printed.
 
+#include <cstdint>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace hybridctl::cli {
 
@@ -21,6 +24,7 @@ struct RunRequest {
 };
 
 // Returns the exit code: kSuccess, or kMachineStopped when the machine stopped first.
-int run_job(const RunRequest& request);
+// `alarms`, when given, receives every alarm raised, in order, with its line.
+int run_job(const RunRequest& request, std::vector<std::pair<std::string, std::uint32_t>>* alarms = nullptr);
 
 }  // namespace hybridctl::cli

@@ -60,7 +60,35 @@ enum class PrimitiveKind {
   SmCons,  ///< "sm-cons": conservative over-cut
 };
 
+/// What a head builds without support (docs/support.md): the layer rule's cone and how far
+/// a bead may span air between two supports. The one definition of the rule the planner's
+/// additive primitives and the simulator's deposition both apply
+/// (instruments/support_rule.hpp).
+struct SupportLimits {
+  double max_overhang = 0.0;            ///< degrees from the build direction, 0 <= a < 90
+  double max_bridge = 0.0;              ///< mm of air between two supports; 0: no bridging
+};
+
 enum class DepositionProcess { DedPowder, DedWire, WireArc, LaserWire };
+
+/// Support limits of a process when the machine file gives none: powder DED 30 degrees,
+/// wire-fed laser and ded-wire 20, wire-arc 15 (torch along the build direction); no
+/// process bridges by default (a metal melt pool needs a substrate).
+constexpr SupportLimits default_support(DepositionProcess p) {
+  switch (p) {
+    case DepositionProcess::DedPowder: return {30.0, 0.0};
+    case DepositionProcess::DedWire: return {20.0, 0.0};
+    case DepositionProcess::LaserWire: return {20.0, 0.0};
+    case DepositionProcess::WireArc: return {15.0, 0.0};
+  }
+  return {0.0, 0.0};
+}
+/// Nozzle tip to programmed point when the machine file gives none: the powder focus of a
+/// coaxial DED nozzle (10 mm), a wire-arc torch's contact tip to work distance (15 mm).
+constexpr double default_standoff(DepositionProcess p) {
+  return p == DepositionProcess::WireArc ? 15.0 : 10.0;
+}
+
 enum class BeadShape { Ellipsoid, Cylinder };
 
 /// The cross-section one pass deposits: the head's minimum manufacturable neighbourhood.
@@ -70,10 +98,12 @@ struct Bead {
   double height = 0.0;                  ///< mm, > 0; required
 };
 
-/// The non-cutting body around the deposition point, used for clearance.
+/// The non-cutting body around the deposition point: a cylinder whose lower end (the
+/// nozzle tip) stands `standoff` above the programmed point (the bead's bottom).
 struct Nozzle {
   double diameter = 0.0;                ///< mm, > 0
   double length = 0.0;                  ///< mm, > 0
+  double standoff = 10.0;               ///< mm, > bead height; the loader's default is by process (default_standoff)
 };
 
 /// Machine codes that switch deposition. `power_template` contains "{power}", which the
@@ -91,6 +121,7 @@ struct AdditiveHead {
   DepositionProcess process = DepositionProcess::DedPowder;  ///< required
   Bead bead;                            ///< required
   std::optional<Nozzle> nozzle;         ///< none: the head body is ignored for clearance
+  SupportLimits support = default_support(DepositionProcess::DedPowder);  ///< default by process
   double layer_height = 0.0;            ///< mm, 0 < h <= bead.height; default 0.8 x bead.height
   double hatch_spacing = 0.0;           ///< mm, 0 < s <= bead.width; default 0.7 x bead.width
   double travel_clearance = 5.0;        ///< mm lifted for travel moves, >= 0

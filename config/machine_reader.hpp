@@ -58,6 +58,8 @@ class MachineReader {
   void read_rotary_axis(const Value& v, char name);
   std::optional<std::size_t> read_heads(const Value& v);
   void read_head(const Value& v);
+  void read_nozzle(const Value& v, AdditiveHead& head, bool bead_known);
+  void read_support(const Value& v, SupportLimits& support);
   void read_deposition_codes(const Value& v, DepositionCodes& codes);
   /// Head tool numbers are unique among heads and never a cutting tool's number.
   void check_head_tool_numbers();

@@ -80,8 +80,8 @@ std::optional<std::size_t> MachineReader::read_heads(const Value& v) {
 
 void MachineReader::read_head(const Value& v) {
   MapReader r(sink_, v,
-              {"name", "process", "bead", "nozzle", "layer_height", "hatch_spacing", "travel_clearance", "feed",
-               "tool_number", "codes", "cost_per_mm3", "primitives"});
+              {"name", "process", "bead", "nozzle", "support", "layer_height", "hatch_spacing", "travel_clearance",
+               "feed", "tool_number", "codes", "cost_per_mm3", "primitives"});
   if (!r.ok()) return;
   AdditiveHead h;
   if (auto f = r.require("name")) {
@@ -100,15 +100,9 @@ void MachineReader::read_head(const Value& v) {
       bead_known = width && height;
     }
   }
-  if (auto f = r.find("nozzle")) {
-    MapReader n(sink_, f->value, {"diameter", "length"});
-    if (n.ok()) {
-      Nozzle nozzle;
-      const auto d = required_length(n, "diameter", nozzle.diameter);
-      const auto l = required_length(n, "length", nozzle.length);
-      if (d && l) h.nozzle = nozzle;
-    }
-  }
+  if (auto f = r.find("nozzle")) read_nozzle(f->value, h, bead_known);
+  h.support = default_support(h.process);
+  if (auto f = r.find("support")) read_support(f->value, h.support);
 
   // Layer height and hatch spacing default to fractions of the bead and may not exceed it.
   if (auto f = r.find("layer_height")) {
@@ -148,6 +142,51 @@ void MachineReader::read_head(const Value& v) {
   if (auto f = r.find("codes")) read_deposition_codes(f->value, h.codes);
   if (auto f = r.find("primitives")) h.primitives = primitives(f->value, kAdditivePrimitives, h.primitives);
   machine_.heads.push_back(std::move(h));
+}
+
+// The nozzle body: its tip stands `standoff` above the programmed point and must clear the
+// bead the head lays (docs/support.md, "The nozzle").
+void MachineReader::read_nozzle(const Value& v, AdditiveHead& h, bool bead_known) {
+  MapReader n(sink_, v, {"diameter", "length", "standoff"});
+  if (!n.ok()) return;
+  Nozzle nozzle;
+  nozzle.standoff = default_standoff(h.process);
+  const auto d = required_length(n, "diameter", nozzle.diameter);
+  const auto l = required_length(n, "length", nozzle.length);
+  bool standoff_ok = true;
+  if (auto f = n.find("standoff")) {
+    const auto s = read_number(sink_, f->value, kLength, Bound::Positive);
+    standoff_ok = s.has_value();
+    if (s) nozzle.standoff = *s;
+    if (s && bead_known && *s <= h.bead.height) {
+      sink_.error(f->value.mark, f->value.path + ": expected more than the bead height " + fmt(h.bead.height) +
+                                     " mm (the nozzle tip must clear the bead it lays), got " + describe(f->value.node));
+      standoff_ok = false;
+    }
+  } else if (bead_known && nozzle.standoff <= h.bead.height) {
+    sink_.error(v.mark, v.path + ": the default standoff " + fmt(nozzle.standoff) + " mm of " +
+                            std::string(to_string(h.process)) + " does not clear the bead height " +
+                            fmt(h.bead.height) + " mm; expected a 'standoff' above it");
+    standoff_ok = false;
+  }
+  if (d && l && standoff_ok) h.nozzle = nozzle;
+}
+
+// What the head builds without support; keys not given keep the process's defaults.
+void MachineReader::read_support(const Value& v, SupportLimits& support) {
+  MapReader r(sink_, v, {"max_overhang", "max_bridge"});
+  if (!r.ok()) return;
+  if (auto f = r.find("max_overhang")) {
+    if (auto a = read_number(sink_, f->value, kAngle, Bound::NonNegative)) {
+      if (*a >= 90)
+        sink_.error(f->value.mark, f->value.path +
+                                       ": expected an angle from the build direction below 90 degrees (90 would be a "
+                                       "horizontal shelf over air), got " + describe(f->value.node));
+      else
+        support.max_overhang = *a;
+    }
+  }
+  number(r, "max_bridge", kLength, Bound::NonNegative, support.max_bridge);
 }
 
 void MachineReader::read_deposition_codes(const Value& v, DepositionCodes& codes) {

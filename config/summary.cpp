@@ -57,7 +57,11 @@ std::string summarize(const Machine& m) {
                        std::string(to_string(h.bead.shape)) + " " + fmt(h.bead.width) + " x " + fmt(h.bead.height) +
                        " mm, layer " + fmt(h.layer_height) + " mm, hatch " + fmt(h.hatch_spacing) + " mm, feed " +
                        fmt(h.feed) + " mm/min, " + primitives(h.primitives);
-    if (h.nozzle) text += ", nozzle ø" + fmt(h.nozzle->diameter) + " x " + fmt(h.nozzle->length) + " mm";
+    text += ", overhang <= " + fmt(h.support.max_overhang) + " deg, " +
+            (h.support.max_bridge > 0 ? "bridges <= " + fmt(h.support.max_bridge) + " mm" : std::string("no bridging"));
+    if (h.nozzle)
+      text += ", nozzle ø" + fmt(h.nozzle->diameter) + " x " + fmt(h.nozzle->length) + " mm at " +
+              fmt(h.nozzle->standoff) + " mm standoff";
     out.item(h.name, text);
   }
 

@@ -80,7 +80,9 @@ void assemble_new_job(const JobRequest& request, Job& job, JobOperator& op) {
     const auto& plan = file.plans[std::size_t(request.rank - 1)];
     gcode::PostOptions post;
     post.program_name = "plan-" + std::to_string(request.rank) + " " + plan.expression;
-    job.program = gcode::post_program(toolpaths::export_plan(file, plan, job.machine).programs(), job.machine, post);
+    job.program = request.plan_program
+                      ? request.plan_program(file, plan, job.machine, post)
+                      : gcode::post_program(toolpaths::export_plan(file, plan, job.machine).programs(), job.machine, post);
     job.text = job.program.text();
     job.header.source = in.string() + " plan " + std::to_string(request.rank);
   } else {
@@ -173,7 +175,11 @@ class ActionTracker {
     for (auto& a : spans_)
       if (a.first <= line) found = &a;
     if (found) found->alarms.emplace_back(protocol::to_string(s.alarm));
+    raised_.emplace_back(protocol::to_string(s.alarm), line);
   }
+
+  // Every alarm raised so far, in order, with its line.
+  const std::vector<std::pair<std::string, std::uint32_t>>& raised() const { return raised_; }
 
   std::vector<ActionReport> report(std::uint32_t executed, Clock::time_point end) const {
     std::vector<ActionReport> out;
@@ -203,6 +209,7 @@ class ActionTracker {
     std::vector<std::string> alarms;
   };
   std::vector<Span> spans_;
+  std::vector<std::pair<std::string, std::uint32_t>> raised_;
 };
 
 // The comment before a program stop: the operator's instructions.
@@ -237,6 +244,7 @@ StreamCallbacks stream_callbacks(JobOperator& op, ActionTracker& actions, const 
     actions.alarm(s);
     return op.clear_alarm(s);
   };
+  cb.warning = [&actions](const protocol::Status& s) { actions.alarm(s); };
   cb.hold_requested = [&op] { return op.hold_requested(); };
   cb.resume_after_hold = [&op](const protocol::Status& s) { return op.resume_after_hold(s); };
   return cb;
@@ -258,6 +266,7 @@ JobResult stream_job(Job& job, JobOperator& op, double wait_for_controller_s) {
   result.lines = job.program.lines.size();
   if (!result.stream.completed) actions.alarm(result.stream.final_status);
   result.actions = actions.report(result.stream.final_status.last_executed_line, Clock::now());
+  result.alarms = actions.raised();
   return result;
 }
 

@@ -14,12 +14,15 @@
 // them runs with no per-action report).
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "drivers/streamer.hpp"
+#include "gcode/post.hpp"
+#include "planner/plan_file.hpp"
 #include "drivers/transport.hpp"
 
 namespace hybridctl::gcode {
@@ -37,6 +40,12 @@ struct JobRequest {
   std::string resume;     ///< job directory to resume
   unsigned from_line = 0; ///< with `resume`: restart the program there (the controller lost it)
   bool machine_override = false;  ///< with a plan: take `machine` even when it is not the plan's
+  /// With a plan: how its program is made. Unset: toolpaths::export_plan on the plan's
+  /// planned states, then gcode::post_program. The CLI gives validation's, which plans each
+  /// action against the material present and refuses a plan that does not make the part.
+  std::function<gcode::PostedProgram(const planner::PlanFile&, const planner::PlanFilePlan&, const config::Machine&,
+                                     const gcode::PostOptions&)>
+      plan_program;
   double wait_for_controller_s = 120;  ///< a controller silent mid-stream is waited for this long (StreamOptions)
 };
 
@@ -75,6 +84,7 @@ struct JobResult {
   std::size_t lines = 0;
   double seconds = 0;  ///< streaming time
   std::vector<ActionReport> actions;
+  std::vector<std::pair<std::string, std::uint32_t>> alarms;  ///< every alarm raised, in order, with its line
 };
 
 /// What the executor tells people and asks them.

@@ -35,7 +35,8 @@ Backoff link_failure_backoff() { return Backoff(std::chrono::milliseconds(100), 
 // Alarms the program itself caused: no operator action makes resuming right.
 bool program_fault(AlarmCode a) {
   return a == AlarmCode::EnvelopeViolation || a == AlarmCode::RapidIntoMaterial || a == AlarmCode::DepositionWithoutHead ||
-         a == AlarmCode::GcodeError || a == AlarmCode::SpindleDepositionConflict || a == AlarmCode::ProgramIdentityMismatch;
+         a == AlarmCode::GcodeError || a == AlarmCode::SpindleDepositionConflict || a == AlarmCode::ProgramIdentityMismatch ||
+         a == AlarmCode::NozzleCollision;
 }
 
 // Thrown from a status read that shows the controller lost the program; caught in run().
@@ -191,6 +192,21 @@ class Session {
     if (cb_.note) cb_.note(s);
     if (journal_) journal_->note(s);
   }
+  // A warning is reported in the status while the controller goes on: said once per code
+  // and line (polling sees the latest one only; the controller's own log has them all).
+  void warned(const protocol::Status& s) {
+    if (s.alarm == AlarmCode::None || !protocol::alarm_info(s.alarm).warning) return;
+    if (s.alarm == warned_code_ && s.alarm_line == warned_line_) return;
+    warned_code_ = s.alarm;
+    warned_line_ = s.alarm_line;
+    ++result_.counters.warnings;
+    const auto& info = protocol::alarm_info(s.alarm);
+    note("warning " + std::string(info.name) + " at line " + std::to_string(s.alarm_line) + ": " +
+         std::string(info.meaning));
+    if (cb_.warning) cb_.warning(s);
+  }
+  AlarmCode warned_code_ = AlarmCode::None;
+  std::uint32_t warned_line_ = 0;
   void seen(const protocol::Status& s) {
     if (auto loss = detect_loss(known_, s, std::uint32_t(lines_.size()))) {
       status_ = s;
@@ -199,6 +215,7 @@ class Session {
     know(s);
     status_ = s;
     if (cb_.status) cb_.status(s);
+    warned(s);
     if (s.boot_count != boot_) {
       boot_ = s.boot_count;
       ++result_.counters.reboots_seen;

@@ -36,6 +36,9 @@ struct StreamCallbacks {
   // An alarm the operator may clear (controller restarted, heartbeat lost): true to send
   // RESET_ALARM and RESUME. Alarms caused by the program itself always end the stream.
   std::function<bool(const protocol::Status&)> recover;
+  // A warning the controller reports while it goes on (protocol::AlarmInfo::warning,
+  // e.g. DEPOSITION_OVER_AIR), once per code and line seen; it is also noted.
+  std::function<void(const protocol::Status&)> warning;
   // Polled between requests: true to hold (FEED_HOLD) — e.g. after Ctrl-C.
   std::function<bool()> hold_requested;
   // While held at the host's request: true to resume, false to abort.
@@ -73,6 +76,7 @@ struct StreamCounters {
   std::uint64_t transport_errors = 0;  // requests the transport gave up on, recovered from here
   std::uint64_t reboots_seen = 0;
   std::uint64_t recoveries = 0;      // alarms cleared with RESET_ALARM + RESUME
+  std::uint64_t warnings = 0;        // warnings seen (code and line changed), the program going on
 };
 
 struct StreamResult {

@@ -38,6 +38,15 @@ struct PathMove {
 
 enum class Process { Deposition, Milling };
 
+// Something that makes the part wrong if the path runs as it is: a layer skipped under
+// material, material the tool cannot reach. Export refuses the plan and validation
+// rejects it (docs/export.md); harmless remarks stay in Toolpath::warnings.
+struct PathDefect {
+  std::string kind;     // "layer_skipped", "unreachable" (plan.json's rejection kinds)
+  std::string message;  // one sentence with the figures
+  Vec3 where;           // mm, work frame: the middle of what is affected
+};
+
 struct Toolpath {
   Process process = Process::Milling;
   std::string instrument;     // head or tool name, as in the machine file
@@ -46,7 +55,8 @@ struct Toolpath {
   Vec3 start;                 // where the path starts, at safe height (work frame)
   double safe_z = 0;          // mm, work frame: above everything the path can meet
   std::vector<PathMove> moves;
-  std::vector<std::string> warnings;  // e.g. deposition with nothing below it
+  std::vector<std::string> warnings;  // e.g. short raster segments dropped
+  std::vector<PathDefect> defects;    // the part will be wrong: see PathDefect
 };
 
 // One action of a plan with its toolpath, ready for the post-processor.

@@ -2,7 +2,14 @@
 
 namespace hybridctl::instruments {
 
-Bead bead_of(const config::AdditiveHead& head) { return Bead{head.bead.shape, head.bead.width, head.bead.height, {}}; }
+Bead bead_of(const config::AdditiveHead& head) {
+  Bead bead{head.bead.shape, head.bead.width, head.bead.height, {}, head.support};
+  if (head.nozzle) {
+    const config::Nozzle& n = *head.nozzle;
+    bead.body.push_back({geometry::AxialSection::Kind::Cylinder, n.standoff, n.standoff + n.length, n.diameter / 2, 0, 0});
+  }
+  return bead;
+}
 
 int head_tool_number(const config::AdditiveHead& head, int fallback) {
   return head.tool_number > 0 ? head.tool_number : fallback;

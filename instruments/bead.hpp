@@ -22,12 +22,16 @@ struct Bead {
   double width = 0;   // mm, the bead's diameter across the path
   double height = 0;  // mm, along +Z
   // Optional non-cutting body (nozzle) above the programmed point, sections in mm along
-  // +Z, checked like a cutter's body; bead_of leaves it empty (the machine file gives no
-  // nozzle standoff).
+  // +Z, checked like a cutter's body.
   std::vector<geometry::AxialSection> body;
+  // What the head builds without support (instruments/support_rule.hpp); bead_of copies
+  // the head's. A hand-built bead has no overhang and no bridge: only straight stacks.
+  config::SupportLimits support;
 };
 
-// The bead of a head: its shape, width and height, with no body.
+// The bead of a head: its shape, width and height, its nozzle body (a cylinder of the
+// nozzle's diameter over [standoff, standoff + length]; none without a nozzle) and its
+// support limits.
 Bead bead_of(const config::AdditiveHead& head);
 
 // The T number that selects a head: its tool_number when positive (the machine loader

@@ -7,6 +7,7 @@
 #include "instruments/cutter.hpp"
 #include "instruments/elements.hpp"
 #include "planner/primitive_shapes.hpp"
+#include "planner/support.hpp"
 
 namespace hybridctl::planner {
 namespace {
@@ -104,14 +105,19 @@ std::vector<Primitive> machine_primitives(const config::Machine& m, const Solid&
         p.setup = setup.name;
         p.cost_per_mm3 = head.cost_per_mm3;
         const Instrument in = bead_instrument(head, setup.approach);
+        // Only what the head builds without support in this setup (planner/support.hpp).
+        const auto buildable = [&](const Solid& region) {
+          return self_supporting(region, instruments::approach_direction(setup.approach),
+                                 instruments::support_rule(head.support, design.voxel_size()));
+        };
         if (kind == config::PrimitiveKind::UAm) {
           p.kind = PrimitiveKind::UAm;
           p.label = "U-AM " + head.name + " " + setup_words(setup);
-          add(p, [&] { return additive_maximal(design, in); });
+          add(p, [&] { return buildable(additive_maximal(design, in)); });
         } else if (kind == config::PrimitiveKind::OAm) {
           p.kind = PrimitiveKind::OAm;
           p.label = "O-AM " + head.name + " " + setup_words(setup);
-          add(p, [&] { return additive_conservative(design, in); });
+          add(p, [&] { return buildable(additive_conservative(design, in)); });
         }
       }
 

@@ -167,6 +167,50 @@ PlanGrid read_plan_grid(const fs::path& given) {
   return g;
 }
 
+namespace {
+
+// The primitive a plan's step names, as an index.
+int primitive_index(const Node& name, const PlanFile& f) {
+  const std::string prim = name.str();
+  for (std::size_t i = 0; i < f.primitives.size(); ++i)
+    if (f.primitives[i].name == prim) return int(i);
+  name.fail("the name of one of the plan's primitives");
+}
+
+RejectionReason read_reason(const Node& n) {
+  RejectionReason r;
+  r.kind = n.at("kind").str();
+  if (n.has("action")) r.action = n.at("action").integer();
+  if (n.has("line")) r.line = n.at("line").integer();
+  if (n.has("message")) r.message = n.at("message").str();
+  if (n.has("where")) r.where = n.at("where").vec3();
+  return r;
+}
+
+// plan.json's `rejected`: candidates validation turned down (docs/plan-format.md).
+void read_rejected(const Node& rejected, PlanFile& f) {
+  for (std::size_t k = 0; k < rejected.size(); ++k) {
+    const Node p = rejected.at(k);
+    PlanFileRejected out;
+    out.expression = p.at("expression").str();
+    out.cost = p.at("cost").number();
+    const Node steps = p.at("steps");
+    for (std::size_t s = 0; s < steps.size(); ++s) {
+      const Node a = steps.at(s);
+      PlanFileAction action;
+      action.primitive = primitive_index(a.at("primitive"), f);
+      if (a.has("volume")) action.volume = a.at("volume").number();
+      if (a.has("cost")) action.cost = a.at("cost").number();
+      out.actions.push_back(action);
+    }
+    const Node reasons = p.at("reasons");
+    for (std::size_t i = 0; i < reasons.size(); ++i) out.reasons.push_back(read_reason(reasons.at(i)));
+    f.rejected.push_back(std::move(out));
+  }
+}
+
+}  // namespace
+
 PlanFile parse_plan_file(std::string_view json_text, const fs::path& json_path) {
   const std::string name = json_path.string();
   const json root = parse_plan_json(json_text, name);
@@ -217,6 +261,7 @@ PlanFile parse_plan_file(std::string_view json_text, const fs::path& json_path) 
     }
     f.plans.push_back(std::move(plan));
   }
+  if (top.has("rejected")) read_rejected(top.at("rejected"), f);
   return f;
 }
 
@@ -241,6 +286,11 @@ PlanFile to_plan_file(const PlanningResult& r, const ReportSources& sources, con
     PlanFilePlan out{int(k + 1), expression(r.problem, plan), plan.cost, {}};
     for (const PlanStep& step : plan.steps) out.actions.push_back({step.primitive, step.volume, step.cost});
     f.plans.push_back(std::move(out));
+  }
+  for (const RejectedPlan& rejected : r.rejected) {
+    PlanFileRejected out{expression(r.problem, rejected.plan), rejected.plan.cost, {}, rejected.reasons};
+    for (const PlanStep& step : rejected.plan.steps) out.actions.push_back({step.primitive, step.volume, step.cost});
+    f.rejected.push_back(std::move(out));
   }
   return f;
 }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "geometry/solid.hpp"
+#include "planner/rejection.hpp"
 #include "planner/search.hpp"
 
 namespace hybridctl::planner {
@@ -42,6 +43,15 @@ struct PlanFilePlan {
   friend bool operator==(const PlanFilePlan&, const PlanFilePlan&) = default;
 };
 
+// A candidate plan that failed when executed (validation/), with its located reasons.
+struct PlanFileRejected {
+  std::string expression;
+  double cost = 0;
+  std::vector<PlanFileAction> actions;
+  std::vector<RejectionReason> reasons;
+  friend bool operator==(const PlanFileRejected&, const PlanFileRejected&) = default;
+};
+
 struct PlanFile {
   std::filesystem::path directory;
   std::string part;                        // relative to `directory` (older plans: as given)
@@ -55,6 +65,7 @@ struct PlanFile {
   geometry::Solid design;
   std::vector<PlanFilePrimitive> primitives;
   std::vector<PlanFilePlan> plans;
+  std::vector<PlanFileRejected> rejected;  // empty in older plans and when nothing was rejected
   // Solids compare by their voxels (geometry::Solid's ==).
   friend bool operator==(const PlanFile&, const PlanFile&) = default;
 };

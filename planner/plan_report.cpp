@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -83,6 +84,68 @@ std::string optimality_text(const Plan& plan, std::size_t k) {
   if (plan.exact) return "proven rank " + std::to_string(k + 1) + " (" + percent + " above the optimum)";
   if (!std::isfinite(plan.gap)) return "no proven bound on its distance from the optimum";
   return "within " + percent + " of optimal (proven)";
+}
+
+json reason_json(const RejectionReason& reason) {
+  json j = {{"kind", reason.kind}};
+  if (reason.action > 0) j["action"] = reason.action;
+  if (reason.line > 0) j["line"] = reason.line;
+  if (!reason.message.empty()) j["message"] = reason.message;
+  if (reason.where) j["where"] = vec(*reason.where);
+  return j;
+}
+
+// Candidates that validation by execution turned down, with their located reasons.
+json rejected_json(const PlanningResult& r) {
+  json rejected = json::array();
+  for (const RejectedPlan& candidate : r.rejected) {
+    json steps = json::array();
+    for (std::size_t s = 0; s < candidate.plan.steps.size(); ++s) {
+      const PlanStep& step = candidate.plan.steps[s];
+      const Primitive& prim = r.primitives[std::size_t(step.primitive)];
+      steps.push_back({{"step", s + 1},
+                       {"primitive", prim.name},
+                       {"mode", mode_name(prim.mode)},
+                       {"volume", step.volume},
+                       {"cost", step.cost}});
+    }
+    json reasons = json::array();
+    for (const RejectionReason& reason : candidate.reasons) reasons.push_back(reason_json(reason));
+    rejected.push_back({{"expression", expression(r.problem, candidate.plan)},
+                        {"cost", candidate.plan.cost},
+                        {"steps", steps},
+                        {"reasons", reasons}});
+  }
+  return rejected;
+}
+
+// One line per candidate that failed when executed, with its first reasons.
+std::string rejected_summary(const PlanningResult& r) {
+  std::ostringstream os;
+  os << "validated   every plan offered was exported and executed from the raw stock; " << r.rejected.size()
+     << " candidate" << (r.rejected.size() == 1 ? "" : "s") << " rejected\n";
+  // One line each: the expression, the cost and the first reason, short; a reason told in
+  // full once (candidates that begin the same way fail the same way).
+  std::vector<std::string> told;
+  for (const RejectedPlan& candidate : r.rejected) {
+    os << "  x " << expression(r.problem, candidate.plan) << "  cost " << fixed(candidate.plan.cost, 4);
+    if (candidate.reasons.empty()) {
+      os << "\n";
+      continue;
+    }
+    const RejectionReason& first = candidate.reasons.front();
+    const std::string text = describe(first);
+    const bool again = std::find(told.begin(), told.end(), text) != told.end();
+    os << ": " << first.kind;
+    if (again)
+      os << " (as above" << (first.action > 0 ? ", action " + std::to_string(first.action) : std::string()) << ")";
+    else
+      os << ": " << text;
+    if (candidate.reasons.size() > 1) os << "; " << candidate.reasons.size() - 1 << " more in plan.json";
+    os << "\n";
+    if (!again) told.push_back(text);
+  }
+  return os.str();
 }
 
 }  // namespace
@@ -202,6 +265,8 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
                      {"actions", actions}});
   }
   doc["plans"] = plans;
+  doc["validated"] = r.validated;
+  doc["rejected"] = rejected_json(r);
   json timings = json::object();
   for (const auto& [phase, seconds] : r.timings) timings[phase] = seconds;
   doc["timings_s"] = timings;
@@ -281,6 +346,7 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
   const std::size_t shown = std::min<std::size_t>(r.verdict.violations.size(), 10);
   for (std::size_t i = 0; i < shown; ++i) os << "  - " << r.verdict.violations[i].description << "\n";
   if (r.verdict.violations.size() > shown) os << "  ... and " << r.verdict.violations.size() - shown << " more in plan.json\n";
+  if (r.validated) os << rejected_summary(r);
   if (!r.plans.empty()) {
     os << "plans       " << r.plans.size() << " (A*: " << r.search.expanded << " states expanded in "
        << fixed(r.search.seconds, 2) << " s";

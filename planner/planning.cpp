@@ -1,5 +1,6 @@
 #include "planner/planning.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -130,18 +131,45 @@ PlanningProblem symbolic_problem(const PlanningResult& r, const config::Planning
   return p;
 }
 
-void search_plans(int top_k, const PlanningOptions& options, const Progress& progress, PlanningResult& r) {
+// The search's accept hook from PlanningOptions::validate: rejected plans are kept with
+// their reasons (once each, as a weighted search may find them again), and the time the
+// validation takes is counted apart from the search's.
+std::function<bool(const Plan&)> accept_hook(const PlanningOptions& options, PlanningResult& r, double& seconds) {
+  if (!options.validate) return {};
+  return [&options, &r, &seconds](const Plan& plan) {
+    const auto same_actions = [&plan](const RejectedPlan& known) {
+      return std::equal(known.plan.steps.begin(), known.plan.steps.end(), plan.steps.begin(), plan.steps.end(),
+                        [](const PlanStep& a, const PlanStep& b) { return a.primitive == b.primitive; });
+    };
+    if (std::any_of(r.rejected.begin(), r.rejected.end(), same_actions)) return false;
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<RejectionReason> reasons = options.validate(r, plan);
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (reasons.empty()) return true;
+    r.rejected.push_back({plan, std::move(reasons)});
+    return false;
+  };
+}
+
+void search_plans(int top_k, const PlanningOptions& options, const Progress& progress, PlanningResult& r,
+                  double& validation_seconds) {
   progress("search", 0);
   SearchOptions search{top_k, options.max_expansions};
   // Plans that differ only in the order of one tool's consecutive actions in one setup
   // are one plan to a shop: the search keeps the cheapest order of each such block.
   search.block_orders = BlockOrders::Cheapest;
   search.time_limit = options.search_time;
+  search.accept = accept_hook(options, r, validation_seconds);
+  search.max_rejected = options.max_rejected;
+  r.validated = bool(options.validate);
   r.plans = find_plans(r.problem, search, &r.search);
   progress("search", 1);
   if (r.plans.empty() && !r.verdict.decided_without_search) {
     r.verdict.manufacturable = false;
-    r.verdict.summary = r.search.limit_reached
+    r.verdict.summary = !r.rejected.empty()
+                            ? "every candidate plan failed when executed (" + std::to_string(r.rejected.size()) +
+                                  " rejected" + (r.search.limit_reached ? ", the search stopped at its limit" : "") + ")"
+                        : r.search.limit_reached
                             ? "undecided: no plan found within the search limits (" + std::to_string(r.search.expanded) +
                                   " states expanded, weighted A* included); no atom rules the part out, but the "
                                   "primitives may not combine into it"
@@ -175,8 +203,14 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
   r.problem = symbolic_problem(r, defaults, options.max_uses);
   r.verdict = check_manufacturability(r.problem, r.measures, r.lattice);
   clock.lap("check");
-  if (r.verdict.manufacturable) search_plans(top_k, options, progress, r);
+  double validation_seconds = 0;
+  if (r.verdict.manufacturable) search_plans(top_k, options, progress, r, validation_seconds);
   clock.lap("search");
+  if (r.validated) {
+    // The search's lap holds the validation it called: report them apart.
+    r.timings.back().second = std::max(0.0, r.timings.back().second - validation_seconds);
+    r.timings.emplace_back("validate", validation_seconds);
+  }
   for (const Plan& plan : r.plans)
     r.deviations.push_back(measure_deviation(plan_outcome(r, plan), r.design, r.domain, r.tolerance));
   clock.lap("deviation");

@@ -12,6 +12,7 @@
 #include "planner/check.hpp"
 #include "planner/deviation.hpp"
 #include "planner/machine_primitives.hpp"
+#include "planner/rejection.hpp"
 #include "planner/search.hpp"
 
 namespace hybridctl::planner {
@@ -22,6 +23,8 @@ struct PrimitiveFile {
   Mode mode = Mode::Additive;
   double cost_per_mm3 = 1.0;
 };
+
+struct PlanningResult;
 
 struct PlanningOptions {
   // Unset values (<= 0, or top_k 0) take the machine file's planning defaults.
@@ -40,6 +43,19 @@ struct PlanningOptions {
   std::uint64_t memory_budget = 0;
   // Progress: a phase name and a fraction of it done.
   std::function<void(const std::string& phase, double fraction)> progress;
+  // Validation by execution (validation/): when set, every plan the search finds is
+  // offered to it, cheapest first, with the result as far as planning has made it (grid,
+  // design, primitives, atoms, problem). No reasons: the plan is kept; reasons: it is
+  // recorded in PlanningResult::rejected and the search goes on to the next candidate,
+  // until top_k plans are kept, the plans run out, or `max_rejected` were turned down.
+  std::function<std::vector<RejectionReason>(const PlanningResult&, const Plan&)> validate;
+  std::int64_t max_rejected = 200;
+};
+
+// A candidate plan that validation turned down, with its reasons.
+struct RejectedPlan {
+  Plan plan;
+  std::vector<RejectionReason> reasons;
 };
 
 struct PlanningResult {
@@ -57,6 +73,8 @@ struct PlanningResult {
   Verdict verdict;
   std::vector<Plan> plans;
   std::vector<Deviation> deviations;  // one per plan: its outcome against the design
+  std::vector<RejectedPlan> rejected;  // candidates validation turned down, in the order found
+  bool validated = false;              // the plans were validated (PlanningOptions::validate)
   SearchStats search;
   std::vector<std::pair<std::string, double>> timings;  // phase, seconds
 };

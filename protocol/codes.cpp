@@ -59,12 +59,19 @@ constexpr std::array<AlarmInfo, kAlarmCodeCount> kAlarms{{
      "Inspect the bead at the stop; RESET_ALARM and RESUME, or ABORT. Send chunks earlier "
      "(keep the buffer fuller) on this transport.",
      true},
-    // 12 and 13 are the simulator's (engineer P's branch brings their full text).
     {AlarmCode::DepositionOverAir, "DEPOSITION_OVER_AIR",
-     "Deposition at the alarm line would lay a bead over air (nothing below it).", "ABORT; re-export the program.",
-     true},
+     "A warning: the bead laid at the alarm line ran over air beyond the head's overhang cone and "
+     "bridge (machine file `support`); that material fell and is missing. The program goes on; "
+     "the warning stays in the status until the next alarm or SET_PROGRAM.",
+     "Finish or ABORT the job; the part misses material from that line on. Re-plan with the "
+     "head's support limits, or deposit a supported envelope and machine it back.",
+     true, true},
     {AlarmCode::NozzleCollision, "NOZZLE_COLLISION",
-     "The deposition nozzle would hit material at the alarm line.", "ABORT; re-export the program.", true},
+     "The deposition head's nozzle body touched material on a feed move at the alarm line (the "
+     "stand-off did not clear what is there); the controller stopped after it.",
+     "ABORT; inspect the nozzle and the part. The program deposits under or beside material "
+     "the nozzle cannot pass: re-plan or re-export it.",
+     true},
     {AlarmCode::LinuxcncError, "LINUXCNC_ERROR",
      "LinuxCNC reported an error the other codes do not name (its error channel; the bridge "
      "logs LinuxCNC's message) and stopped the program at the alarm line.",
@@ -219,12 +226,12 @@ std::optional<ResultCode> result_code_from_wire(std::uint16_t value) {
 }
 
 std::string alarm_table_markdown() {
-  std::string out = "| Code | Name | Line | Meaning | What the operator does |\n";
-  out += "|---:|---|:---:|---|---|\n";
+  std::string out = "| Code | Name | Line | Kind | Meaning | What the operator does |\n";
+  out += "|---:|---|:---:|:---:|---|---|\n";
   for (const auto& a : kAlarms) {
     out += "| " + std::to_string(static_cast<unsigned>(a.code)) + " | `" + std::string(a.name) +
-           "` | " + (a.has_line ? "yes" : "-") + " | " + cell(a.meaning) + " | " + cell(a.action) +
-           " |\n";
+           "` | " + (a.has_line ? "yes" : "-") + " | " + (a.warning ? "warning" : "stop") + " | " + cell(a.meaning) +
+           " | " + cell(a.action) + " |\n";
   }
   return out;
 }

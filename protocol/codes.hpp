@@ -58,8 +58,8 @@ enum class AlarmCode : std::uint16_t {
   SpindleDepositionConflict = 9,
   ControllerRestarted = 10,
   DepositionStarved = 11,
-  DepositionOverAir = 12,  // the simulator's (engineer P's branch brings its text)
-  NozzleCollision = 13,    // the simulator's (engineer P's branch brings its text)
+  DepositionOverAir = 12,
+  NozzleCollision = 13,
   LinuxcncError = 14,      // the LinuxCNC bridge (docs/bridge.md)
   LinuxcncLost = 15,       // the LinuxCNC bridge (docs/bridge.md)
 };
@@ -97,6 +97,9 @@ struct AlarmInfo {
   std::string_view meaning;   ///< what happened
   std::string_view action;    ///< what the operator should do
   bool has_line;              ///< status `alarm_line` names the G-code line at fault
+  /// A warning: the controller reports it (status `alarm`, `alarm_line`) and goes on in
+  /// its state; every other alarm stops the machine in ALARM.
+  bool warning = false;
 };
 
 /// One row of the result-code table.

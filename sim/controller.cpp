@@ -60,6 +60,14 @@ struct Controller::Impl {
                      ": " + what);
   }
 
+  // A warning (protocol::AlarmInfo::warning): reported in the status and the run report,
+  // the state stays as it is; it latches until the next alarm or SET_PROGRAM.
+  void warn(AlarmCode code, std::uint32_t line, const std::string& what) {
+    alarm = code;
+    alarm_line = line;
+    alarms.push_back("line " + std::to_string(line) + ": " + std::string(protocol::to_string(code)) + " (warning): " + what);
+  }
+
   bool aborted = false;  // ABORT arrived (in ALARM it takes effect at RESET_ALARM)
   bool finished() const { return acceptor.has_program() && last_executed_line >= acceptor.line_count(); }
 
@@ -200,9 +208,13 @@ struct Controller::Impl {
       case Stop::DepositionWithoutHead: raise(AlarmCode::DepositionWithoutHead, number, o.message); return false;
       case Stop::SpindleDepositionConflict: raise(AlarmCode::SpindleDepositionConflict, number, o.message); return false;
       case Stop::RapidIntoMaterial:
+      case Stop::NozzleCollision:
         // The crash has happened: the line counts as executed, the machine stops.
         break;
     }
+    // A bead over air fell: a warning, the program goes on (docs/simulator.md).
+    for (const Incident& inc : o.incidents)
+      if (inc.kind == IncidentKind::UnsupportedDeposition) warn(AlarmCode::DepositionOverAir, number, describe(inc));
     ++next_in_chunk;
     last_executed_line = number;
     executed.push_back(number);
@@ -212,8 +224,9 @@ struct Controller::Impl {
       ++chunks_executed;
       chunk.reset();
     }
-    if (o.stop == Stop::RapidIntoMaterial) {
-      raise(AlarmCode::RapidIntoMaterial, number, o.message);
+    if (o.stop == Stop::RapidIntoMaterial || o.stop == Stop::NozzleCollision) {
+      raise(o.stop == Stop::RapidIntoMaterial ? AlarmCode::RapidIntoMaterial : AlarmCode::NozzleCollision, number,
+            o.message);
       return false;
     }
     for (const gcode::Event& e : o.events) {

@@ -103,6 +103,15 @@ ProgramExecutor& ProgramExecutor::operator=(ProgramExecutor&&) noexcept = defaul
 
 const gcode::ModalState& ProgramExecutor::state() const { return impl_->interp.state(); }
 
+void ProgramExecutor::set_protected_region(std::optional<Solid> protected_region) {
+  Impl& i = *impl_;
+  i.options.protected_region = std::move(protected_region);
+  if (!i.sim) return;  // enter_frame turns it into the next setup's frame
+  std::optional<Solid> guard;
+  if (i.options.protected_region) guard = turned(*i.options.protected_region, i.domain, i.frame->approach, true);
+  i.sim->set_protected_region(std::move(guard));
+}
+
 Solid ProgramExecutor::stock() const {
   Impl& i = *impl_;
   if (!i.part_stock) return Solid();
@@ -199,11 +208,15 @@ LineOutcome ProgramExecutor::execute_line(std::string_view text, int number) {
     move.line = m.line;
     const MoveReport r = cutter != i.cutters.end() ? i.sim->cut(cutter->second, move) : i.sim->deposit(bead->second, move);
     out.incidents.insert(out.incidents.end(), r.incidents.begin(), r.incidents.end());
-    for (const Incident& inc : r.incidents)
-      if (inc.kind == IncidentKind::RapidIntoMaterial && out.stop == Stop::None) {
-        out.stop = Stop::RapidIntoMaterial;
+    // A crash stops the machine once it has happened; a bead that fell does not (the
+    // controller warns, sim/controller.cpp).
+    for (const Incident& inc : r.incidents) {
+      const bool nozzle = inc.kind == IncidentKind::BodyCollision && bead != i.beads.end();
+      if ((inc.kind == IncidentKind::RapidIntoMaterial || nozzle) && out.stop == Stop::None) {
+        out.stop = nozzle ? Stop::NozzleCollision : Stop::RapidIntoMaterial;
         out.message = where() + describe(inc);
       }
+    }
     if (out.stop != Stop::None) break;
   }
   out.motions = std::move(done);

@@ -41,6 +41,7 @@ enum class Stop {
   DepositionWithoutHead,      // a deposition code with a cutting tool (or none) in the spindle
   SpindleDepositionConflict,  // spindle and deposition on together
   RapidIntoMaterial,          // a rapid met material (after it happened)
+  NozzleCollision,            // a head's feed move touched material with the nozzle body (after it happened)
 };
 
 struct LineOutcome {
@@ -64,6 +65,11 @@ class ProgramExecutor {
   // deposition, spindle) or would leave the envelope is refused whole: the machine stays
   // as it was before it.
   LineOutcome execute_line(std::string_view text, int number);
+
+  // The voxels cuts must spare from the next line on (part frame), in place of
+  // ExecutorOptions::protected_region: validation protects per action what that action
+  // keeps of the design (planner/start_stock.hpp).
+  void set_protected_region(std::optional<geometry::Solid> protected_region);
 
   const gcode::ModalState& state() const;
   // The stock now (part frame); empty solid when there is no stock.

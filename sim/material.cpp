@@ -3,8 +3,12 @@
 #include <algorithm>
 #include <bit>
 #include <climits>
+#include <limits>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
+
+#include "instruments/support_rule.hpp"
 
 namespace hybridctl::sim {
 namespace {
@@ -128,6 +132,97 @@ void for_each_word(RowMask& mask, geometry::Solid& stock, bool z_descending, Fn&
   }
 }
 
+// Lays a bead's swept voxels (`mask`) on the stock by the head's layer rule
+// (instruments/support_rule.hpp), applied to the bead as one layer of the build: a column
+// of the bead's footprint is held when the rule holds its cell on the material under the
+// bead (the plate below the domain, or any material from one voxel layer below the bead's
+// bottom up to its middle height, what it fuses with); the new voxels of a column not held
+// fell and are counted in `fallen`, not added. The rule's cone and slack are per voxel
+// layer, so a bead taller than a voxel is judged at least as leniently as the planner's
+// layers judge the same deposit; what matters is caught: beads laid over air.
+struct BeadLaying {
+  geometry::Solid& stock;
+  const IndexBox& domain;
+  int plate;  // the first layer above the build plate
+  const instruments::SupportRule& rule;
+  const geometry::Lattice& lattice;
+  std::span<const Segment> axis;  // the bead's axis: the path of the programmed point, mm
+  Tally added, overlap, fallen;
+
+  void lay(RowMask& mask) {
+    if (mask.empty()) return;
+    const IndexBox rows = geometry::box_intersection(mask.box, domain);
+    if (rows.empty()) return;
+    // Room around the bead for the cone's reach and a bridge's far anchor.
+    const int reach = int(std::ceil(rule.reach(1))) + rule.max_bridge_voxels + 1;
+    const int gx0 = std::max(domain.lo.x, rows.lo.x - reach), gx1 = std::min(domain.hi.x, rows.hi.x + reach);
+    const int gy0 = std::max(domain.lo.y, rows.lo.y - reach), gy1 = std::min(domain.hi.y, rows.hi.y + reach);
+    instruments::LayerGrid candidates(gx0, gy0, gx1 - gx0, gy1 - gy0), under(gx0, gy0, gx1 - gx0, gy1 - gy0);
+    std::vector<Index3> fresh;  // voxels of the bead not yet material
+    for (int z = rows.lo.z; z < rows.hi.z; ++z)
+      for (int y = rows.lo.y; y < rows.hi.y; ++y) {
+        const std::uint64_t* m = mask.row(y, z);
+        for (int w = std::max(mask.w0, word_of(rows.lo.x)); w < mask.w1; ++w)
+          for (std::uint64_t bits = m[w]; bits; bits &= bits - 1) {
+            const int x = w * kWordBits + std::countr_zero(bits);
+            if (x < rows.lo.x || x >= rows.hi.x) continue;
+            if (stock.contains({x, y, z})) {
+              overlap.add(std::uint64_t{1} << (x - w * kWordBits), w, y, z);
+            } else {
+              fresh.push_back({x, y, z});
+              candidates.set(x, y);
+            }
+          }
+      }
+    if (fresh.empty()) return;
+    const int bottom = mask.box.lo.z, middle = (mask.box.lo.z + mask.box.hi.z - 1) / 2;
+    // The bead is one layer of the build: it looks back one layer, to what it rests on
+    // and fuses with; on the plate it needs nothing.
+    const bool on_plate = bottom <= plate;
+    if (!on_plate)
+      for (int y = gy0; y < gy1; ++y)
+        for (int x = gx0; x < gx1; ++x)
+          for (int z = bottom - 1; z <= middle; ++z)
+            if (stock.contains({x, y, z})) {
+              under.set(x, y);
+              break;
+            }
+    const instruments::Below below{1, under};
+    const instruments::LayerGrid held =
+        instruments::supported_cells(candidates, std::span(&below, on_plate ? 0 : 1), under, rule).held;
+    // A bead is one melt pool: where its axis is held (by the rule, or resting on material),
+    // its whole cross-section is, edges overhanging the layer below included. That is the
+    // usual criterion for DED and wire-arc beads (a bead holds while its centre is over
+    // what it is laid on and the cone's lean), and it is what makes the planner's voxel
+    // layers, whose edge beads spill half a bead beyond, agree with the simulator.
+    auto axis_held = [&](int x, int y) {
+      const geometry::Vec3 c = lattice.center({x, y, 0});
+      double best = std::numeric_limits<double>::infinity();
+      geometry::Vec3 at = c;
+      for (const Segment& s : axis) {
+        const double dx = s.to.x - s.from.x, dy = s.to.y - s.from.y, len2 = dx * dx + dy * dy;
+        const double t = len2 > 0 ? std::clamp(((c.x - s.from.x) * dx + (c.y - s.from.y) * dy) / len2, 0.0, 1.0) : 0.0;
+        const geometry::Vec3 p{s.from.x + t * dx, s.from.y + t * dy, 0};
+        const double d = (p.x - c.x) * (p.x - c.x) + (p.y - c.y) * (p.y - c.y);
+        if (d < best) best = d, at = p;
+      }
+      const int ax = int(std::floor((at.x - lattice.origin.x) / lattice.voxel_size));
+      const int ay = int(std::floor((at.y - lattice.origin.y) / lattice.voxel_size));
+      return held.filled(ax, ay) || under.filled(ax, ay);
+    };
+    for (const Index3& v : fresh) {
+      const int w = word_of(v.x);
+      const std::uint64_t bit = std::uint64_t{1} << (v.x - w * kWordBits);
+      if (!held.filled(v.x, v.y) && !axis_held(v.x, v.y)) {
+        fallen.add(bit, w, v.y, v.z);
+        continue;
+      }
+      stock.set(v);
+      added.add(bit, w, v.y, v.z);
+    }
+  }
+};
+
 }  // namespace
 
 std::string_view to_string(IncidentKind kind) {
@@ -154,12 +249,19 @@ std::string describe(const Incident& i) {
 
 MaterialSimulation::MaterialSimulation(geometry::Solid stock, std::optional<geometry::Solid> protected_region,
                                        SimulationOptions options)
-    : stock_(std::move(stock)), protected_(std::move(protected_region)), options_(options) {
+    : stock_(std::move(stock)), options_(options) {
   domain_ = stock_.storage_box();
+  plate_ = domain_.lo.z;
+  empty_ = stock_.empty();
   if (domain_.empty()) throw std::invalid_argument("the stock must have a non-empty storage box (the simulated domain)");
-  if (protected_ && !(protected_->lattice() == stock_.lattice()))
-    throw std::invalid_argument("the protected solid must share the stock's lattice");
+  set_protected_region(std::move(protected_region));
   if (!(options_.arc_tolerance >= 0)) throw std::invalid_argument("arc tolerance must be >= 0");
+}
+
+void MaterialSimulation::set_protected_region(std::optional<geometry::Solid> protected_region) {
+  if (protected_region && !(protected_region->lattice() == stock_.lattice()))
+    throw std::invalid_argument("the protected solid must share the stock's lattice");
+  protected_ = std::move(protected_region);
 }
 
 double MaterialSimulation::chord_tolerance() const {
@@ -253,26 +355,22 @@ MoveReport MaterialSimulation::deposit(const Bead& bead, const MaterialMove& mov
             if (!row_inside || w < dw0 || w >= dw1) outside.add(m[w], w, y, z);
         }
     }
-    Tally added, overlap;
-    bool supported = false;
-    auto lay = [&] {
-      // Top rows first, so the row below still holds the material from before the move.
-      for_each_word(bead_mask, stock_, true, [&](int y, int z, int w, std::uint64_t m, std::uint64_t& s) {
-        overlap.add(s & m, w, y, z);
-        added.add(m & ~s, w, y, z);
-        if (!supported)
-          supported = (s & m) != 0 || z == domain_.lo.z || (stock_.word_at(w, y, z - 1) & m) != 0;
-        s |= m;
-      });
-    };
+    const instruments::SupportRule rule = instruments::support_rule(bead.support, stock_.voxel_size());
+    // Nothing there yet: the program builds from a plate, whose top is where it lays its
+    // first bead (a plan that starts by depositing starts at the design's lowest layer).
+    if (empty_ && !bead_mask.empty()) plate_ = std::max(plate_, bead_mask.box.lo.z);
+    BeadLaying laying{stock_, domain_, plate_, rule, lattice, segments, {}, {}, {}};
     // The body sits above the bead: fresh material can reach it only on a falling move.
     if (move.to.z < move.from.z) {
-      lay();
+      laying.lay(bead_mask);
       touch(body_mask);
     } else {
       touch(body_mask);
-      lay();
+      laying.lay(bead_mask);
     }
+    const Tally& added = laying.added;
+    const Tally& overlap = laying.overlap;
+    if (added.voxels > 0) empty_ = false;
     out.deposited = double(added.voxels) * v;
     out.overlap = double(overlap.voxels) * v;
     out.outside = double(outside.voxels) * v;
@@ -283,7 +381,7 @@ MoveReport MaterialSimulation::deposit(const Bead& bead, const MaterialMove& mov
       out.collision = double(contact.voxels) * v;
       incident(IncidentKind::BodyCollision, contact);
     }
-    if (!supported) incident(IncidentKind::UnsupportedDeposition, added);
+    incident(IncidentKind::UnsupportedDeposition, laying.fallen);
     incident(IncidentKind::DepositionOutsideDomain, outside);
   } else {
     // Travel: a rapid must keep bead and body out of material, a feed move the body.

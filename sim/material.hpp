@@ -32,7 +32,7 @@ enum class IncidentKind {
   RapidIntoMaterial,        // a rapid touched material (cutter or body; bead or nozzle)
   BodyCollision,            // a feed move touched material with the non-cutting body
   Gouge,                    // a move removed voxels of the protected solid
-  UnsupportedDeposition,    // a bead touched no material and rested on nothing
+  UnsupportedDeposition,    // bead voxels laid over air beyond the head's cone or bridge: they fell, not added
   DepositionOutsideDomain,  // a bead reached beyond the simulated domain: that part is lost
 };
 std::string_view to_string(IncidentKind kind);
@@ -72,8 +72,9 @@ class MaterialSimulation {
  public:
   // `stock`: the material at the start. Its storage box is the simulated domain: nothing
   // exists beyond it, deposition beyond it is lost (and reported), and its lowest voxel
-  // layer stands on the build plate. `protected_region`: voxels that must not be removed
-  // (the design grown by its tolerance), on the stock's lattice (std::invalid_argument
+  // layer stands on the build plate; an empty stock stands for a plate whose top is where
+  // the first bead is laid. `protected_region`: voxels that must not be removed
+  // (e.g. the design shrunk by its tolerance), on the stock's lattice (std::invalid_argument
   // otherwise).
   explicit MaterialSimulation(geometry::Solid stock, std::optional<geometry::Solid> protected_region = std::nullopt,
                               SimulationOptions options = {});
@@ -81,12 +82,18 @@ class MaterialSimulation {
   // Moves the cutter: removes what its cutting part sweeps, checks its body. A rapid
   // also cuts (the spindle turns) and reports all material the cutter or body touched.
   MoveReport cut(const Cutter& cutter, const MaterialMove& move);
-  // Moves the head: with the process on, adds what the bead sweeps; otherwise a rapid
-  // reports the material its bead or body would touch, a feed move what its body touches.
+  // Moves the head: with the process on, adds what the bead sweeps where the head's layer
+  // rule holds it (on the plate under the domain, on material under the bead within its
+  // overhang cone, or bridged; docs/simulation.md); what lies over air beyond that falls
+  // and is reported (UnsupportedDeposition). Otherwise a rapid reports the material its bead
+  // or body would touch, a feed move what its body (the nozzle) touches.
   MoveReport deposit(const Bead& bead, const MaterialMove& move);
 
   const geometry::Solid& stock() const { return stock_; }
   const std::optional<geometry::Solid>& protected_region() const { return protected_; }
+  // The voxels cuts must spare from the next move on (same rules as the constructor's):
+  // what a plan protects changes from action to action (planner/start_stock.hpp).
+  void set_protected_region(std::optional<geometry::Solid> protected_region);
   const SimulationReport& report() const { return report_; }
   const SimulationOptions& options() const { return options_; }
 
@@ -99,6 +106,10 @@ class MaterialSimulation {
   SimulationOptions options_;
   geometry::IndexBox domain_;
   SimulationReport report_;
+  // The build plate lies under this layer: the domain's lowest, or, on a stock that was
+  // empty, the first bead's lowest layer (docs/support.md, "In the simulator").
+  int plate_ = 0;
+  bool empty_ = true;  // no material in the stock yet
   // Reused scratch words for one move's swept voxels (instrument, body).
   std::vector<std::uint64_t> scratch_[2];
 };

@@ -10,6 +10,7 @@
 
 #include "common/number_text.hpp"
 #include "instruments/bead.hpp"
+#include "instruments/support_rule.hpp"
 #include "toolpaths/setup_frame.hpp"
 #include "toolpaths/slices.hpp"
 
@@ -199,7 +200,7 @@ class DepositionBuilder {
   // The ROI's voxel layers whose centres lie in the band [zb, zb + layer_height); `k` the highest.
   SliceMask layer_region(double zb, int& k) const;
   void drop_blocked(SliceMask& region, int k, int layer, double zb);
-  void warn_overhangs(const SliceMask& region, int layer, double zb);
+  void drop_overhangs(SliceMask& region, int layer, double zb);
   std::vector<Pass> passes_of(const SliceMask& region, int layer, double angle);
   void finish();
 
@@ -227,8 +228,8 @@ class DepositionBuilder {
   // Emission state.
   bool started_ = false;
   Vec3 at_{};
-  int warnings_overhang_ = 0, warnings_blocked_ = 0, dropped_total_ = 0;
-  double overhang_area_total_ = 0, blocked_area_total_ = 0;
+  int warnings_overhang_ = 0, dropped_total_ = 0;
+  double overhang_area_total_ = 0;
 };
 
 void DepositionBuilder::run(const Solid& roi_all, const Solid& existing) {
@@ -260,8 +261,14 @@ void DepositionBuilder::take_parameters() {
   lh_ = head_.layer_height, s_ = head_.hatch_spacing, w_ = head_.bead.width;
   inset_ = options_.edge_inset.value_or(w_ / 2);
   min_length_ = options_.min_segment_length.value_or(w_);
-  support_gap_ = options_.support_gap.value_or(lh_);
-  reach_ = options_.overhang_reach.value_or(w_ / 2);
+  // The simulator rests a bead on material in the voxel layer just under its bottom
+  // (sim/material.cpp): a column top within half a voxel below the layer's bottom. A
+  // layer's worth of gap would count the layer before last as support.
+  support_gap_ = options_.support_gap.value_or(h_ / 2);
+  // A bead is held where its axis lies within the head's one-layer reach of what is below
+  // (instruments/support_rule.hpp, as the simulator judges it), and never more than half a
+  // bead beyond it.
+  reach_ = options_.overhang_reach.value_or(std::min(w_ / 2, instruments::support_rule(head_.support, h_).reach(1) * h_));
   gap_ = std::max(0.0, options_.approach_gap);
   corridor_ = std::max(w_ / 2, head_.nozzle ? head_.nozzle->diameter / 2 : 0.0);
   angles_ = options_.raster_angles_deg.empty() ? std::vector<double>{0.0} : options_.raster_angles_deg;
@@ -388,14 +395,20 @@ void DepositionBuilder::drop_blocked(SliceMask& region, int k, int layer, double
   if (n == 0) return;
   region = region.without(blocked);
   const double area = double(n) * h_ * h_;
-  blocked_area_total_ += area;
-  if (++warnings_blocked_ <= kMaxWarningsPerKind)
-    path_.warnings.push_back("layer " + std::to_string(layer + 1) + " at z=" + mm(zb) + " mm: " + mm(area) +
-                             " mm^2 lie under existing material, out of reach from the approach side; skipped");
+  // The part would lack this deposit: a defect (export refuses, validation rejects).
+  const CellBox b = cell_bounds(blocked);
+  const Vec3 middle{lattice_.origin.x + 0.5 * (b.x0 + b.x1) * h_, lattice_.origin.y + 0.5 * (b.y0 + b.y1) * h_, zb};
+  path_.defects.push_back({"layer_skipped", "layer " + std::to_string(layer + 1) + " at z=" + mm(zb) + " mm: " +
+                                                mm(area) + " mm^2 lie under existing material, out of reach from "
+                                                "the approach side; skipped",
+                           middle});
 }
 
-// Overhangs: deposit with nothing (existing, deposited, plate) close enough below.
-void DepositionBuilder::warn_overhangs(const SliceMask& region, int layer, double zb) {
+// Overhangs: deposit with nothing (existing, deposited, plate) close enough below is not
+// laid: a bead over air falls (docs/support.md), so the head never deposits there; what the
+// part then lacks is the plan's to answer for (validation compares the part made with the
+// design). The layers above see no material there and are cut back in turn.
+void DepositionBuilder::drop_overhangs(SliceMask& region, int layer, double zb) {
   SliceMask supported = empty_mask_;
   const bool on_plate = zb - plate_z_ <= support_gap_ + 1e-9;
   for (int y = window_.lo.y; y < window_.hi.y; ++y)
@@ -406,12 +419,13 @@ void DepositionBuilder::warn_overhangs(const SliceMask& region, int layer, doubl
   const SliceMask overhang = region.without(grow_by_disc(supported, reach_ / h_));
   const std::int64_t n = overhang.count();
   if (n == 0) return;
+  region = region.without(overhang);
   const CellBox b = cell_bounds(overhang);
   const double area = double(n) * h_ * h_;
   overhang_area_total_ += area;
   if (++warnings_overhang_ <= kMaxWarningsPerKind)
     path_.warnings.push_back("overhang: layer " + std::to_string(layer + 1) + " at z=" + mm(zb) + " mm has " + mm(area) +
-                             " mm^2 of deposit with nothing below it, within x " + mm(lattice_.origin.x + b.x0 * h_) +
+                             " mm^2 with nothing below it, not deposited, within x " + mm(lattice_.origin.x + b.x0 * h_) +
                              ".." + mm(lattice_.origin.x + b.x1 * h_) + ", y " + mm(lattice_.origin.y + b.y0 * h_) +
                              ".." + mm(lattice_.origin.y + b.y1 * h_) + " mm (work frame)");
 }
@@ -441,7 +455,8 @@ void DepositionBuilder::deposit_layer(int layer, double zb) {
   if (region.empty()) return;
   drop_blocked(region, k, layer, zb);
   if (region.empty()) return;
-  warn_overhangs(region, layer, zb);
+  drop_overhangs(region, layer, zb);
+  if (region.empty()) return;
   // This layer's beads count at their full height for travels from its first pass on.
   for (int y = window_.lo.y; y < window_.hi.y; ++y)
     for (int x = window_.lo.x; x < window_.hi.x; ++x)
@@ -473,10 +488,7 @@ void DepositionBuilder::finish() {
   }
   if (warnings_overhang_ > kMaxWarningsPerKind)
     path_.warnings.push_back("overhang: " + std::to_string(warnings_overhang_) + " layers in all, " +
-                             mm(overhang_area_total_) + " mm^2 of deposit with nothing below it");
-  if (warnings_blocked_ > kMaxWarningsPerKind)
-    path_.warnings.push_back(std::to_string(warnings_blocked_) + " layers in all have ROI under existing material (" +
-                             mm(blocked_area_total_) + " mm^2), skipped");
+                             mm(overhang_area_total_) + " mm^2 with nothing below it, not deposited");
   if (dropped_total_ > 0)
     path_.warnings.push_back(std::to_string(dropped_total_) + " raster segments shorter than " + mm(min_length_) +
                              " mm dropped (narrow parts of the region stay unfilled)");

@@ -49,11 +49,12 @@ struct DepositionOptions {
   // bottom face of the lowest voxel of the ROI and the existing material.
   std::optional<double> build_plate_z;
   // Deposit is supported when material (existing, deposited, the plate) ends at most this
-  // far (mm) below the layer's bottom. Default: the layer height.
+  // far (mm) below the layer's bottom. Default: half a voxel (the voxel layer under the bead's bottom).
   std::optional<double> support_gap;
   // Deposit within this distance (mm, sideways) of supported deposit counts as supported:
-  // a bead may overhang its support by a fraction of its width. Default: half the bead
-  // width.
+  // a bead may overhang its support by a fraction of its width; farther is not laid.
+  // Default: the head's one-layer reach (instruments/support_rule.hpp), at most half the
+  // bead width.
   std::optional<double> overhang_reach;
   // Rapids stop this far (mm) above the material under the bead's footprint (beads
   // counted at their full height); the head comes down onto the surface, and leaves a
@@ -70,9 +71,10 @@ struct DepositionOptions {
 //   existing  material present before the action, part frame, same lattice (may be empty)
 //   head      the additive head: bead, layer_height, hatch_spacing, travel_clearance, feed
 //   setup     the setup: its approach becomes the work frame's +Z; its name is recorded
-// Moves are in mm in the work frame. Warnings: overhangs (deposit with nothing below),
-// ROI under existing material (not reachable from the approach side: skipped), dropped
-// short segments. A layer height, hatch spacing or feed left at 0 takes the machine
+// Moves are in mm in the work frame. Defects (Toolpath::defects, the part will be wrong):
+// ROI under existing material, not reachable from the approach side, is skipped
+// ("layer_skipped", one per layer). Warnings: overhangs (region with nothing below: not laid),
+// dropped short segments. A layer height, hatch spacing or feed left at 0 takes the machine
 // file's default (0.8 x bead height, 0.7 x bead width, 1000 mm/min). Throws
 // std::invalid_argument on solids on different lattices or a head without a bead.
 Toolpath deposition_path(const geometry::Solid& roi, const geometry::Solid& existing, const config::AdditiveHead& head,

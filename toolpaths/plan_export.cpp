@@ -13,6 +13,44 @@ const config::Setup& setup_named(const config::Machine& m, const planner::PlanFi
                    "'; expected one of its setups");
 }
 
+// The action's toolpath from its region of influence in the material it meets.
+void make_program(const planner::PlanFilePrimitive& p, const config::Machine& machine, const ExportOptions& options,
+                  ExportedAction& a) {
+  const config::Setup& setup = setup_named(machine, p);
+  ActionProgram& prog = a.program;
+  prog.action = a.step;
+  prog.primitive = p.name;
+  prog.label = p.label;
+  prog.additive = p.mode == planner::Mode::Additive;
+  prog.volume = a.roi.volume();
+  if (prog.additive) {
+    const config::AdditiveHead* head = nullptr;
+    std::size_t index = 0;
+    for (const auto& h : machine.heads) {
+      if (h.name == p.capability) {
+        head = &h;
+        break;
+      }
+      ++index;
+    }
+    if (!head) throw InputError(p.name + " (" + p.label + "): the machine has no head '" + p.capability + "'");
+    DepositionOptions d = options.deposition;
+    d.fallback_tool_number = instruments::head_tool_number(machine, index);
+    prog.path = deposition_path(a.roi, a.before, *head, setup, d);
+  } else {
+    const config::CuttingTool* tool = machine.find_tool(p.tool_number);
+    if (!tool) throw InputError(p.name + " (" + p.label + "): the machine has no tool T" + std::to_string(p.tool_number));
+    prog.path = pocket_path(a.roi, a.after, a.before, *tool, setup, options.pocket);
+  }
+  // A path with no move makes no G-code: its block would only approach the path's
+  // (meaningless) start. Why stays in the note, its defects in the program.
+  a.makes_gcode = !prog.path.moves.empty();
+  if (!a.makes_gcode) {
+    const auto& why = prog.path.defects.empty() ? prog.path.warnings : std::vector<std::string>{prog.path.defects[0].message};
+    a.note = "no toolpath" + (why.empty() ? std::string() : ": " + why.front());
+  }
+}
+
 }  // namespace
 
 std::vector<ActionProgram> PlanExport::programs() const {
@@ -22,62 +60,46 @@ std::vector<ActionProgram> PlanExport::programs() const {
   return out;
 }
 
+std::vector<std::string> path_defects(const PlanExport& exported) {
+  std::vector<std::string> out;
+  for (const ExportedAction& a : exported.actions)
+    for (const gcode::PathDefect& d : a.program.path.defects)  // made or not
+      out.push_back("action " + std::to_string(a.step) + " (" + a.primitive + "): " + d.message);
+  return out;
+}
+
 PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
-                       const ExportOptions& options) {
+                       const ExportOptions& options, const MaterialAfter& material_after) {
   if (file.machine_name != machine.name)
     throw InputError("the plan was made for machine '" + file.machine_name + "', not '" + machine.name +
                      "'; expected the machine file it was planned with (" + file.machine_file + ")");
   PlanExport out;
-  const std::vector<geometry::Solid> states = planner::plan_states(file, plan);
+  const std::vector<geometry::Solid> planned = planner::plan_states(file, plan);
+  geometry::Solid present = planned.front();
   const int n = int(plan.actions.size());
   for (int k = 0; k < n; ++k) {
     if (options.progress) options.progress(k + 1, n);
     const planner::PlanFilePrimitive& p = file.primitives[std::size_t(plan.actions[std::size_t(k)].primitive)];
+    const bool additive = p.mode == planner::Mode::Additive;
     ExportedAction a;
     a.step = k + 1;
     a.primitive = p.name;
-    a.before = states[std::size_t(k)];
-    a.after = states[std::size_t(k) + 1];
-    a.roi = p.mode == planner::Mode::Additive ? subtract(p.region, a.before) : intersect(a.before, p.region);
+    a.before = material_after ? present : planned[std::size_t(k)];
+    a.after = material_after ? (additive ? unite(a.before, p.region) : subtract(a.before, p.region))
+                             : planned[std::size_t(k) + 1];
+    a.roi = additive ? subtract(p.region, a.before) : intersect(a.before, p.region);
     if (p.raw_stock()) {
       out.raw_stock = p.label;
       a.note = "clamp the raw stock: " + p.label;
     } else if (a.roi.empty()) {
-      a.note = "nothing to " + std::string(p.mode == planner::Mode::Additive ? "deposit" : "remove") + " in this state";
+      a.note = "nothing to " + std::string(additive ? "deposit" : "remove") + " in this state";
     } else if (p.kind == "file") {
       throw InputError(p.name + " is a primitive from the file " + p.capability +
                        ": no head or tool of the machine is known to make it; expected machine primitives only");
     } else {
-      const config::Setup& setup = setup_named(machine, p);
-      ActionProgram& prog = a.program;
-      prog.action = k + 1;
-      prog.primitive = p.name;
-      prog.label = p.label;
-      prog.additive = p.mode == planner::Mode::Additive;
-      prog.volume = a.roi.volume();
-      if (prog.additive) {
-        const config::AdditiveHead* head = nullptr;
-        std::size_t index = 0;
-        for (const auto& h : machine.heads) {
-          if (h.name == p.capability) {
-            head = &h;
-            break;
-          }
-          ++index;
-        }
-        if (!head)
-          throw InputError(p.name + " (" + p.label + "): the machine has no head '" + p.capability + "'");
-        DepositionOptions d = options.deposition;
-        d.fallback_tool_number = instruments::head_tool_number(machine, index);
-        prog.path = deposition_path(a.roi, a.before, *head, setup, d);
-      } else {
-        const config::CuttingTool* tool = machine.find_tool(p.tool_number);
-        if (!tool)
-          throw InputError(p.name + " (" + p.label + "): the machine has no tool T" + std::to_string(p.tool_number));
-        prog.path = pocket_path(a.roi, a.after, a.before, *tool, setup, options.pocket);
-      }
-      a.makes_gcode = true;
+      make_program(p, machine, options, a);
     }
+    if (material_after) present = material_after(a);
     out.actions.push_back(std::move(a));
   }
   return out;

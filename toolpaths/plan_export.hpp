@@ -2,6 +2,10 @@
 // A plan's actions as G-code: replay the plan on the voxels, take each action's region of
 // influence in the state it meets (deposit: P minus the material there; removal: the
 // material there inside P), make its toolpath in its setup's frame, and post-process.
+// The state an action meets is the plan's planned state, or, when the layer above runs
+// the programs (ExportOptions::material_after, validation/), the material really present
+// after the previous actions' toolpaths: travel, clearance heights and blocked columns are
+// then planned against what the machine will meet.
 //
 // The raw stock action makes no G-code: the operator clamps the stock (its name goes in
 // the program header). Actions whose region is empty in their state are skipped with a
@@ -30,17 +34,21 @@ struct ExportOptions {
   std::function<void(int action, int actions)> progress;
 };
 
-// One action of the plan with its geometry, as planned.
+// One action of the plan with its geometry.
 struct ExportedAction {
   int step = 0;                // 1-based in the plan
   std::string primitive;       // P-name
-  bool makes_gcode = false;    // false for the raw stock and for empty regions
+  bool makes_gcode = false;    // false for the raw stock, empty regions and paths with no move
   std::string note;            // why not, or the stock to clamp
-  geometry::Solid before;      // planned material before the action (part frame)
-  geometry::Solid after;       // planned material after it
-  geometry::Solid roi;         // its region of influence in that state
-  ActionProgram program;       // when makes_gcode
+  geometry::Solid before;      // material the action meets (part frame): planned, or present (material_after)
+  geometry::Solid after;       // `before` with the action's primitive applied (AM unites, SM subtracts)
+  geometry::Solid roi;         // its region of influence in `before`
+  ActionProgram program;       // when makes_gcode; a path with no move keeps its defects here
 };
+
+// The material present after an action, as the layer above finds it by running the
+// action's program (part frame, on the plan's lattice and domain).
+using MaterialAfter = std::function<geometry::Solid(const ExportedAction& made)>;
 
 struct PlanExport {
   std::string raw_stock;                 // label of the stock the plan starts from, if any
@@ -50,7 +58,14 @@ struct PlanExport {
 
 // Throws hybridctl::InputError when the plan was made for another machine, or an action
 // needs an instrument or setup the machine does not have.
+// `material_after`, when given, is asked after every action (the raw stock and actions
+// with nothing to do included) and the next action meets what it returns instead of the
+// planned state.
 PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
-                       const ExportOptions& options = {});
+                       const ExportOptions& options = {}, const MaterialAfter& material_after = {});
+
+// The path defects of the actions, each as "action K (P..): message".
+// Export refuses a plan that has any (docs/export.md): the part would be wrong.
+std::vector<std::string> path_defects(const PlanExport& exported);
 
 }  // namespace hybridctl::toolpaths

@@ -320,7 +320,16 @@ void PocketBuilder::report_what_stays() {
   if (skipped_entries_ > 0)
     path_.warnings.push_back(std::to_string(skipped_entries_) +
                              " passes skipped: the shank or holder would meet material on the way down to them");
-  if (!started_) path_.warnings.push_back("no tool position reaches the region without touching what must remain");
+  // Nothing of the region reached at all: the action cannot be made (a defect). What a
+  // started path leaves (corners a round tool cannot reach) is judged by the part as built
+  // against the tolerance (validation/), so it stays a warning.
+  if (!started_ && left > 0) {
+    const geometry::Box3 b = lattice_.extent(remaining_.bounding_box());
+    path_.defects.push_back({"unreachable", "no tool position reaches the region without touching what must remain",
+                             {(b.min.x + b.max.x) / 2, (b.min.y + b.max.y) / 2, (b.min.z + b.max.z) / 2}});
+  } else if (!started_) {
+    path_.warnings.push_back("no tool position reaches the region without touching what must remain");
+  }
 }
 
 Toolpath& PocketBuilder::run(const Solid& roi, const Solid& keep, const Solid& stock) {

@@ -69,7 +69,10 @@ struct PocketOptions {
 //   tool          the cutting tool: diameter, type, flute, shank, holder, feeds, steps
 //   setup         its approach becomes the work frame's +Z; its name is recorded
 // All solids on one lattice (std::invalid_argument otherwise). Moves in mm, work frame.
-// Warnings: ROI the tool cannot reach (volume), entries with no room to ramp.
+// Defects (Toolpath::defects, the part will be wrong): no tool position reaches the ROI
+// at all ("unreachable"). Warnings: ROI the tool cannot reach (volume and extent: corners
+// a round tool leaves; the part as built judges them against the tolerance), entries with
+// no room to ramp, passes skipped because the shank or holder would meet material.
 Toolpath pocket_path(const geometry::Solid& roi, const geometry::Solid& keep, const geometry::Solid& stock_before,
                      const config::CuttingTool& tool, const config::Setup& setup, const PocketOptions& options = {});
 

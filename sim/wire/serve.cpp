@@ -10,6 +10,7 @@
 
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
+#include "planner/start_stock.hpp"
 #include "config/transport_uri.hpp"
 #include "geometry/memory_estimate.hpp"
 #include "geometry/mesh.hpp"
@@ -88,9 +89,9 @@ CheckedOptions check_options(const ServeOptions& o) {
 }
 
 // The stock, and the region the cuts must spare, from a plan directory: the chosen plan's
-// first action's primitive when it is a raw stock (else an empty stock on the plan's
-// domain), and the design shrunk by the tolerance. Returns what the stock is, for the report.
-std::string stock_from_plan(const ServeOptions& o, ControllerOptions& options) {
+// first action's primitive when it is a raw stock (else an empty stock), on the plan's
+// domain, and the design shrunk by the tolerance. Returns what the stock is, for the report.
+std::string stock_from_plan(const ServeOptions& o, const config::Machine& machine, ControllerOptions& options) {
   const planner::PlanFile file = planner::read_plan_file(o.stock_plan);
   if (file.plans.empty()) throw InputError(o.stock_plan + ": the plan file holds no plans (the part was not manufacturable)");
   if (o.plan < 1 || o.plan > int(file.plans.size())) {
@@ -101,14 +102,17 @@ std::string stock_from_plan(const ServeOptions& o, ControllerOptions& options) {
   const planner::PlanFilePrimitive* first =
       plan.actions.empty() ? nullptr : &file.primitives.at(std::size_t(plan.actions.front().primitive));
   std::string described;
+  // As validation executes plans (planner/start_stock.hpp): over the plan's domain, the
+  // build plate under the first deposit of a plan that starts with deposition.
+  options.stock = planner::start_stock(file, plan, machine);
   if (first && first->raw_stock()) {
-    options.stock = first->region;
     described = "raw stock " + first->name + " (" + first->capability + ") of plan " + std::to_string(o.plan);
   } else {
-    options.stock = geometry::Solid(file.lattice, file.domain);
     described = "empty (plan " + std::to_string(o.plan) + " starts with deposition)";
   }
-  options.protected_region = geometry::erode(file.design, geometry::Ball{file.tolerance});
+  // The whole design shrunk by the tolerance: the controller does not follow which action
+  // a line belongs to, so a removal the plan refills later (SM-cons) counts as gouge here.
+  options.protected_region = planner::spared_by_cuts(file);
   return described;
 }
 
@@ -273,7 +277,7 @@ ServeOutcome serve(const ServeOptions& o, const std::function<void(const std::st
   check_stock_memory(o);
   ControllerOptions options = controller_options(o, checked.faults);
   std::string stock = "none";
-  if (!o.stock_plan.empty()) stock = stock_from_plan(o, options);
+  if (!o.stock_plan.empty()) stock = stock_from_plan(o, machine, options);
   if (!o.stock_vdb.empty()) {
     options.stock = geometry::read_vdb(o.stock_vdb);
     stock = o.stock_vdb;

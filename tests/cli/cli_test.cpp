@@ -146,7 +146,7 @@ namespace {
 const std::string kMachine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/hybrid-3axis.yaml";
 
 TEST_F(Cli, PlansTheBracketAndWritesPlanJsonWithValidPlans) {
-  const Outcome r = run({"plan", kBracket, "--machine", kMachine, "--voxel", "1", "-o", (dir_ / "plan").string()});
+  const Outcome r = run({"plan", "--no-validate", kBracket, "--machine", kMachine, "--voxel", "1", "-o", (dir_ / "plan").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("verdict     manufacturable"), std::string::npos) << r.out;
   const std::string json = slurp(dir_ / "plan" / "plan.json");
@@ -164,12 +164,12 @@ TEST_F(Cli, PlansTheBracketAndWritesPlanJsonWithValidPlans) {
   EXPECT_TRUE(fs::exists(dir_ / "plan" / "primitives" / "P1.vdb"));
   EXPECT_TRUE(fs::exists(dir_ / "plan" / "plans" / "plan-1.vdb"));
   // Planning again over the earlier output replaces it.
-  EXPECT_EQ(run({"plan", kBracket, "--machine", kMachine, "--voxel", "1", "--top", "2", "-o", (dir_ / "plan").string()}).exit_code, 0);
+  EXPECT_EQ(run({"plan", "--no-validate", kBracket, "--machine", kMachine, "--voxel", "1", "--top", "2", "-o", (dir_ / "plan").string()}).exit_code, 0);
 }
 
 TEST_F(Cli, PlanRefusesToReplaceADirectoryThatIsNotAPlan) {
   write("precious.txt", "keep me");
-  const Outcome r = run({"plan", kBracket, "--machine", kMachine, "--voxel", "1", "-o", dir_.string()});
+  const Outcome r = run({"plan", "--no-validate", kBracket, "--machine", kMachine, "--voxel", "1", "-o", dir_.string()});
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_NE(r.err.find("refusing to replace"), std::string::npos) << r.err;
   EXPECT_EQ(slurp(dir_ / "precious.txt"), "keep me");
@@ -201,7 +201,7 @@ TEST_F(Cli, PlanArgumentsAreChecked) {
 
 TEST_F(Cli, PrimitivesMayComeFromFiles) {
   // The part itself as an additive primitive: one deposition makes it exactly.
-  const Outcome r = run({"plan", kBracket, "--machine", kMachine, "--voxel", "2", "--primitive", kBracket + ":am", "-o",
+  const Outcome r = run({"plan", "--no-validate", kBracket, "--machine", kMachine, "--voxel", "2", "--primitive", kBracket + ":am", "-o",
                          (dir_ / "p").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("additive primitive from " + kBracket), std::string::npos) << r.out;

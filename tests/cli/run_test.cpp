@@ -1,4 +1,4 @@
-// hybridctl run and dry-run end to end: the bracket's best plan streamed to a simulated
+// hybridctl run and dry-run end to end: the flanged hub's best plan streamed to a simulated
 // controller, a separate `hybridctl sim serve` process on 127.0.0.1, over Modbus TCP, Modbus
 // RTU (socat pty pair) and socketcand, also under fault injection and after the host is
 // killed. The simulator's line log must equal the program: every line once, in order.
@@ -79,8 +79,11 @@ class Run : public ::testing::Test {
     fs::remove_all(dir_);
   }
 
-  // The bracket planned once at 0.5 mm into DIR/plan (shared by the tests of one process,
-  // removed when it exits). Three plans: the third deposits, then mills with three tools.
+  // The flanged hub planned once at 0.5 mm into DIR/plan (shared by the tests of one
+  // process, removed when it exits). Three plans, each proven by execution: the raw plate
+  // milled from below, the part turned over by hand (a program stop), then milled from above;
+  // the third mills with T1, then T2. (The bracket has no plan on this machine: the roof of its
+  // horizontal hole can be neither deposited nor milled from above or below.)
   static fs::path plan() {
     struct PlanDir {
       fs::path dir = fs::temp_directory_path() / ("hybridctl-run-plan-" + std::to_string(::getpid()));
@@ -89,7 +92,7 @@ class Run : public ::testing::Test {
     static const PlanDir plan_dir;
     static const fs::path p = [] {
       const fs::path d = plan_dir.dir;
-      const std::string cmd = command({"plan", (kSource / "examples/parts/bracket.stl").string(), "--machine", kMachine,
+      const std::string cmd = command({"plan", (kSource / "examples/parts/flanged-hub.stl").string(), "--machine", kMachine,
                                        "--voxel", "0.5", "--top", "3", "-o", (d / "plan").string()}) +
                               " >/dev/null 2>&1";
       EXPECT_EQ(std::system(cmd.c_str()), 0);
@@ -129,7 +132,7 @@ class Run : public ::testing::Test {
   void expect_exactly_once(const Background& sim) {
     sim.wait_exit(10);
     const std::string program = slurp(dir_ / "job" / "program.ngc"), log = slurp(dir_ / "lines.ngc");
-    EXPECT_GT(program.size(), 100000u);
+    EXPECT_GT(program.size(), 30000u);
     EXPECT_TRUE(log == program) << "the simulator executed " << std::count(log.begin(), log.end(), '\n') << " lines; the program has "
                                 << std::count(program.begin(), program.end(), '\n') << "\n"
                                 << slurp(dir_ / "run.err").substr(0, 3000);
@@ -176,9 +179,9 @@ TEST_F(Run, TheBestPlanOverSocketcand) {
   expect_exactly_once(*sim);
 }
 
-TEST_F(Run, ConnectionsDroppedEveryFiftyRequests) {
+TEST_F(Run, ConnectionsDroppedEveryTenRequests) {
   int port = 0;
-  auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "0", "--drop-every", "50"}, "modbus-tcp", port);
+  auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "0", "--drop-every", "10"}, "modbus-tcp", port);
   EXPECT_EQ(run({"run", plan().string(), "--machine", kMachine, "--transport", "modbus-tcp://127.0.0.1:" + std::to_string(port),
                  "--job", (dir_ / "job").string(), "--yes"}),
             0)
@@ -187,30 +190,30 @@ TEST_F(Run, ConnectionsDroppedEveryFiftyRequests) {
   const std::string out = slurp(dir_ / "run.out");
   std::smatch m;
   ASSERT_TRUE(std::regex_search(out, m, std::regex("([0-9]+) reconnects"))) << out;
-  EXPECT_GE(std::stoi(m[1]), 20) << "the drops did happen and were recovered from";
+  EXPECT_GE(std::stoi(m[1]), 15) << "the drops did happen and were recovered from";
 }
 
 TEST_F(Run, ASimulatorRebootMidActionResumesAtTheSafePoint) {
   int port = 0;
-  auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "0", "--reboot-after-lines", "12000"}, "modbus-tcp", port);
+  auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "0", "--reboot-after-lines", "2000"}, "modbus-tcp", port);
   EXPECT_EQ(run({"run", plan().string(), "--machine", kMachine, "--transport", "modbus-tcp://127.0.0.1:" + std::to_string(port),
                  "--job", (dir_ / "job").string(), "--yes"}),
             0)
       << slurp(dir_ / "run.err");
   expect_exactly_once(*sim);
   // The host says what happened and where it resumed.
-  EXPECT_NE(slurp(dir_ / "run.err").find("controller restarted (boot 2): its buffer was lost; resending from line 12001"),
+  EXPECT_NE(slurp(dir_ / "run.err").find("controller restarted (boot 2): its buffer was lost; resending from line 2001"),
             std::string::npos)
       << slurp(dir_ / "run.err");
   // The final report puts the alarm on the action it struck, with the action's lines and time.
   const std::string out = slurp(dir_ / "run.out");
-  EXPECT_TRUE(std::regex_search(out, std::regex(R"(  action 1: .* (\d+)/\1 lines  [0-9.]+ s  alarms CONTROLLER_RESTARTED\n)"))) << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(  action 2: .* (\d+)/\1 lines  [0-9.]+ s  alarms CONTROLLER_RESTARTED\n)"))) << out;
 }
 
-// Deposition, then three milling tools, on the stock as the simulator built it (beads spill
-// past the plan's voxels): every rapid clears the material really there, so the program
-// runs to its end without RAPID_INTO_MATERIAL and with every line once.
-TEST_F(Run, AMillingPlanRunsOnTheStockAsDeposited) {
+// Two tools and a setup change, each action planned against the stock as the actions before
+// it left it: every rapid clears the material really there, so the program runs to its end
+// without RAPID_INTO_MATERIAL and with every line once.
+TEST_F(Run, APlanWithTwoToolsRunsToItsEndOnTheStockAsMilled) {
   int port = 0;
   auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "0", "--plan", "3"}, "modbus-tcp", port);
   EXPECT_EQ(run({"run", plan().string(), "--plan", "3", "--machine", kMachine, "--transport",
@@ -219,7 +222,8 @@ TEST_F(Run, AMillingPlanRunsOnTheStockAsDeposited) {
       << slurp(dir_ / "run.out") << slurp(dir_ / "run.err");
   expect_exactly_once(*sim);
   const std::string out = slurp(dir_ / "run.out");
-  EXPECT_NE(out.find("subtractive milling with T3"), std::string::npos) << out;
+  EXPECT_NE(out.find("subtractive milling with T1"), std::string::npos) << out;
+  EXPECT_NE(out.find("subtractive milling with T2"), std::string::npos) << out;
   const std::string report = slurp(dir_ / "report.json");
   EXPECT_TRUE(std::regex_search(report, std::regex(R"("final_status":\s*\{[^}]*"state":\s*"COMPLETED")"))) << report;
 }
@@ -230,7 +234,7 @@ TEST_F(Run, AMillingPlanRunsOnTheStockAsDeposited) {
 TEST_F(Run, HeavyRandomFaultsAreRiddenOutExactlyOnce) {
   int port = 0;
   auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "0", "--fault-seed", "11", "--drop-every", "3",
-                    "--corrupt-every", "40", "--delay-ms", "2", "--reboot-after-lines", "9000,21000"},
+                    "--corrupt-every", "40", "--delay-ms", "2", "--reboot-after-lines", "1000,2500"},
                    "modbus-tcp", port);
   EXPECT_EQ(run({"run", plan().string(), "--machine", kMachine, "--transport", "modbus-tcp://127.0.0.1:" + std::to_string(port),
                  "--job", (dir_ / "job").string(), "--yes"}),
@@ -247,8 +251,8 @@ TEST_F(Run, HeavyRandomFaultsAreRiddenOutExactlyOnce) {
 
 TEST_F(Run, AHostKilledMidProgramResumesFromItsJournal) {
   int port = 0;
-  // Slow enough to kill the host mid-program: the 2 h program at 2000x is about 3.5 s.
-  auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "2000"}, "modbus-tcp", port);
+  // Slow enough to kill the host mid-program: the 15 min program at 200x is about 4.5 s.
+  auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "200"}, "modbus-tcp", port);
   {
     Background host(command({"run", plan().string(), "--machine", kMachine, "--transport",
                              "modbus-tcp://127.0.0.1:" + std::to_string(port), "--job", (dir_ / "job").string(), "--yes"}),
@@ -268,7 +272,7 @@ TEST_F(Run, AHostKilledMidProgramResumesFromItsJournal) {
 
 TEST_F(Run, CtrlCHoldsTheFeedAndWithoutAnOperatorAborts) {
   int port = 0;
-  auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "2000"}, "modbus-tcp", port, false);
+  auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "200"}, "modbus-tcp", port, false);
   Background host(command({"run", plan().string(), "--machine", kMachine, "--transport",
                            "modbus-tcp://127.0.0.1:" + std::to_string(port), "--job", (dir_ / "job").string(), "--yes"}),
                   dir_, "host");
@@ -293,7 +297,7 @@ TEST_F(Run, CtrlCHoldsTheFeedAndWithoutAnOperatorAborts) {
 // host waits, and says so every few seconds in its log and on its status line.
 TEST_F(Run, AFeedHoldAtTheMachineIsWaitedOnOutLoud) {
   int port = 0;
-  auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "2000", "--hold-at-line", "200"}, "modbus-tcp", port,
+  auto sim = serve({"--modbus", "tcp://127.0.0.1:0", "--time-scale", "200", "--hold-at-line", "200"}, "modbus-tcp", port,
                    false);
   Background host(command({"run", plan().string(), "--machine", kMachine, "--transport",
                            "modbus-tcp://127.0.0.1:" + std::to_string(port), "--job", (dir_ / "job").string(), "--yes"}),
@@ -317,14 +321,9 @@ TEST_F(Run, AFeedHoldAtTheMachineIsWaitedOnOutLoud) {
 }
 
 TEST_F(Run, ASetupChangeStopsForTheOperatorAndGoesOnWhenAcknowledged) {
-  // The thin-wall slot's best plan mills from below, then from above: the part is turned
-  // over by hand in between (manual_refixture), a program stop with the operator's message.
-  const fs::path plan_dir = dir_ / "slot";
-  ASSERT_EQ(std::system((command({"plan", (kSource / "examples/parts/thin-wall-slot.stl").string(), "--machine", kMachine,
-                                   "--voxel", "0.5", "--top", "1", "-o", plan_dir.string()}) +
-                         " >/dev/null 2>&1")
-                            .c_str()),
-            0);
+  // The flanged hub's best plan mills from below, then from above: the part is turned over
+  // by hand in between (manual_refixture), a program stop with the operator's message.
+  const fs::path plan_dir = plan().parent_path();
   std::vector<std::string> args = {"sim", "serve", "--machine", kMachine, "--stock", (plan_dir / "plan.json").string(),
                                    "--exit-when-done", "--line-log", (dir_ / "lines.ngc").string(), "--modbus",
                                    "tcp://127.0.0.1:0", "--time-scale", "0"};
@@ -392,8 +391,9 @@ TEST_F(Run, ModbusRtuOverASocatPtyPair) {
   expect_exactly_once(sim);
 }
 
+// The fins, a part the fixture's plan does not share: dry-run plans it itself.
 TEST_F(Run, DryRunComparesAsBuiltWithAsPlanned) {
-  const std::string cmd = command({"dry-run", (kSource / "examples/parts/bracket.stl").string(), "--machine", kMachine,
+  const std::string cmd = command({"dry-run", (kSource / "examples/parts/fins.stl").string(), "--machine", kMachine,
                                    "--voxel", "0.5", "-o", (dir_ / "out").string()}) +
                           " >" + quote((dir_ / "dry.out").string()) + " 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << slurp(dir_ / "dry.out");
@@ -406,19 +406,21 @@ TEST_F(Run, DryRunComparesAsBuiltWithAsPlanned) {
   // The replay bounds of docs/export.md: overfill within 10 %, left empty within 2 %.
   EXPECT_LE(extra, 0.10 * planned);
   EXPECT_LE(missing, 0.02 * planned);
-  EXPECT_TRUE(slurp(dir_ / "out" / "executed-lines.ngc") == slurp(dir_ / "out" / "job" / "program.ngc"));
+  EXPECT_TRUE(slurp(dir_ / "out" / "plan-1" / "executed-lines.ngc") == slurp(dir_ / "out" / "plan-1" / "job" / "program.ngc"));
 }
 
 }  // namespace
 
 namespace {
 
-// A `sim serve` on a given port (0: any), with its own line log; returns the port.
+// A `sim serve` on a given port (0: any), with its own line log and the stock of the plan
+// `stock` (none when empty); returns the port.
 int start_sim(std::unique_ptr<Background>& sim, const fs::path& dir, const std::string& name, int port, const std::string& time_scale,
               const std::string& stock) {
-  const std::vector<std::string> args = {"sim", "serve", "--machine", kMachine, "--stock", stock, "--line-log",
-                                         (dir / (name + ".ngc")).string(), "--modbus", "tcp://127.0.0.1:" + std::to_string(port),
-                                         "--time-scale", time_scale, "--exit-when-done"};
+  std::vector<std::string> args = {"sim", "serve", "--machine", kMachine, "--line-log", (dir / (name + ".ngc")).string(),
+                                   "--modbus", "tcp://127.0.0.1:" + std::to_string(port), "--time-scale", time_scale,
+                                   "--exit-when-done"};
+  if (!stock.empty()) args.insert(args.end(), {"--stock", stock});
   sim = std::make_unique<Background>(command(args), dir, name);
   for (int i = 0; i < kStartupPolls; ++i) {
     std::smatch m;
@@ -438,7 +440,7 @@ std::uint32_t journal_executed(const fs::path& journal) {
   return at == std::string::npos ? 0 : std::uint32_t(std::stoul(j.substr(at + 16)));
 }
 
-// A controller power cycle mid-program: the simulator killed (SIGKILL) at about line 3000
+// A controller power cycle mid-program: the simulator killed (SIGKILL) at about line 1500
 // and a new one started on the same port, with no program and no safe point. The host
 // waits for it (beyond the transport's reconnect attempts), stops at the first status of
 // the new controller, says what ran, what may have, and what to do; `run --resume --from-line` then runs the rest once.
@@ -449,9 +451,9 @@ TEST_F(Run, AControllerPowerLossStopsTheHostWhichSaysWhatRanAndResumesFromTheSaf
   const std::string uri = "modbus-tcp://127.0.0.1:" + std::to_string(port);
   Background host(command({"run", plan().string(), "--machine", kMachine, "--transport", uri, "--job", (dir_ / "job").string(), "--yes"}),
                   dir_, "host");
-  for (int i = 0; i < 1200 && journal_executed(dir_ / "job" / "journal.jsonl") < 3000; ++i)
+  for (int i = 0; i < 1200 && journal_executed(dir_ / "job" / "journal.jsonl") < 1500; ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  ASSERT_GE(journal_executed(dir_ / "job" / "journal.jsonl"), 3000u) << slurp(dir_ / "host.err").substr(0, 2000);
+  ASSERT_GE(journal_executed(dir_ / "job" / "journal.jsonl"), 1500u) << slurp(dir_ / "host.err").substr(0, 2000);
   ::kill(first->pid, SIGKILL);
   first->wait_exit(5);
   // A power cycle outlasts the transport's reconnect attempts (about 11 s): the host says
@@ -460,7 +462,9 @@ TEST_F(Run, AControllerPowerLossStopsTheHostWhichSaysWhatRanAndResumesFromTheSaf
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   ASSERT_NE(slurp(dir_ / "host.err").find("the controller does not answer"), std::string::npos) << slurp(dir_ / "host.err");
   ASSERT_TRUE(host.alive()) << slurp(dir_ / "host.err").substr(0, 2000);
-  ASSERT_GT(start_sim(second, dir_, "sim2", port, "0", plan().string()), 0);
+  // The new simulator starts without stock: what the first one milled died with it (a real
+  // machine keeps its part); the subject here is the host's journal and the restart.
+  ASSERT_GT(start_sim(second, dir_, "sim2", port, "0", ""), 0);
   // The documented bound (docs/drivers.md): the first status read once the controller
   // answers again, at most one reconnect backoff step (2 s) after it is back.
   const auto back = std::chrono::steady_clock::now();

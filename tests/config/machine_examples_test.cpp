@@ -37,6 +37,9 @@ TEST(MachineExamples, Hybrid3AxisLoads) {
   EXPECT_EQ(ded->hatch_spacing, 1.05);
   ASSERT_TRUE(ded->nozzle.has_value());
   EXPECT_EQ(ded->nozzle->length, 60.0);
+  EXPECT_EQ(ded->nozzle->standoff, 10.0);
+  EXPECT_EQ(ded->support.max_overhang, 30.0);
+  EXPECT_EQ(ded->support.max_bridge, 0.0);
   EXPECT_EQ(ded->codes.on, "M64 P0");
   EXPECT_EQ(ded->codes.off, "M65 P0");
   EXPECT_EQ(ded->codes.power_template, "M68 E0 Q{power}");

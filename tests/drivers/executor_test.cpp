@@ -12,6 +12,7 @@
 
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
+#include "geometry/vdb_file.hpp"
 #include "gcode/post.hpp"
 #include "sample_programs.hpp"
 #include "sim_process.hpp"
@@ -34,7 +35,8 @@ struct RecordingOperator : drivers::JobOperator {
     ++progress_calls;
     EXPECT_LE(p.action, p.actions);
   }
-  void note(const std::string&) override {}
+  std::vector<std::string> notes;
+  void note(const std::string& n) override { notes.push_back(n); }
   bool continue_after_stop(const protocol::Status&, const std::string& message) override {
     stop_messages.push_back(message);
     return true;
@@ -85,6 +87,34 @@ TEST(Executor, AProgramFileReportsPerActionFromItsHeadings) {
     EXPECT_TRUE(a.seconds.has_value());
     EXPECT_TRUE(a.alarms.empty());
   }
+  EXPECT_EQ(sim.wait(std::chrono::seconds(20)), 0);
+}
+
+TEST(Executor, AWarningOfTheControllerIsReportedWithItsLineAndTheJobGoesOn) {
+  const std::string machine_file = test::example_machine();
+  const fs::path dir = test::scratch_dir("executor-warning");
+  // A plate with a pillar 8 mm high at x [0, 10] and a post far away (the world's height);
+  // the DED head lays a track on the pillar and on past its edge into the air (line 7).
+  const geometry::Lattice lattice{0.5, {0, 0, 0}};
+  geometry::Solid stock = geometry::Solid::filled(lattice, geometry::IndexBox{{0, 0, 0}, {80, 40, 4}});
+  stock = geometry::unite(stock, geometry::Solid::filled(lattice, geometry::IndexBox{{0, 0, 4}, {20, 40, 20}}));
+  stock = geometry::unite(stock, geometry::Solid::filled(lattice, geometry::IndexBox{{76, 36, 4}, {80, 40, 40}}));
+  geometry::write_vdb(stock, dir / "stock.vdb");
+  test::SimProcess sim({"--machine", machine_file, "--modbus", "tcp://127.0.0.1:0", "--time-scale", "0", "--exit-when-done",
+                        "--stock-vdb", (dir / "stock.vdb").string()});
+  drivers::JobRequest request;
+  request.input = write_file(dir / "over-air.ngc", "%\nG21 G90\nG54\nT100 M6\nG0 X2 Y10 Z30\nG1 Z10 F800\nM64 P0\n"
+                                                   "G1 X20 F800\nM65 P0\nG1 Z30 F800\nM2\n%\n");
+  request.machine = machine_file;
+  request.transport = "modbus-tcp://127.0.0.1:" + std::to_string(sim.modbus_port());
+  request.job = (dir / "job").string();
+  RecordingOperator op;
+  const drivers::JobResult result = drivers::execute_job(request, op);
+  ASSERT_TRUE(result.stream.completed) << result.stream.stopped_because;
+  EXPECT_EQ(result.stream.counters.warnings, 1u);
+  bool said = false;
+  for (const std::string& n : op.notes) said = said || n.rfind("warning DEPOSITION_OVER_AIR at line 8: ", 0) == 0;
+  EXPECT_TRUE(said) << "notes: " << ::testing::PrintToString(op.notes);
   EXPECT_EQ(sim.wait(std::chrono::seconds(20)), 0);
 }
 

@@ -66,5 +66,47 @@ TEST(PlanInMemory, EqualsThePlanReadBackFromItsDirectory) {
   }
 }
 
+// PlanningOptions::validate turns candidates down: the planner keeps them with their
+// reasons, goes on to the next, and plan.json's `rejected` reads back as it was written.
+TEST(PlanInMemory, RejectedCandidatesAreKeptWithTheirReasonsAndReadBack) {
+  const std::string machine_text = config::read_machine_text(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
+  const config::Machine machine = config::parse_machine(machine_text, "hybrid-3axis.yaml");
+  const geometry::TriangleMesh part = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/bracket.stl");
+  PlanningOptions options;
+  options.voxel_size = 1.0;
+  options.top_k = 2;
+  const PlanningResult unvalidated = plan_part(part, "bracket.stl", machine, options);
+  ASSERT_EQ(unvalidated.plans.size(), 2u);
+  int offered = 0;
+  options.validate = [&offered](const PlanningResult&, const Plan&) {
+    // The two cheapest candidates fail, located and not.
+    ++offered;
+    if (offered == 1) return std::vector<RejectionReason>{{"gouge", 2, 6112, "a cut into the core", geometry::Vec3{1.5, 2.25, 3}}};
+    if (offered == 2) return std::vector<RejectionReason>{{"missing_material", 0, 0, "the fin is missing", std::nullopt}};
+    return std::vector<RejectionReason>{};
+  };
+  const PlanningResult result = plan_part(part, "bracket.stl", machine, options);
+  EXPECT_TRUE(result.validated);
+  ASSERT_EQ(result.rejected.size(), 2u);
+  ASSERT_EQ(result.plans.size(), 2u);
+  EXPECT_EQ(expression(result.problem, result.rejected[0].plan), expression(unvalidated.problem, unvalidated.plans[0]));
+  EXPECT_EQ(expression(result.problem, result.rejected[1].plan), expression(unvalidated.problem, unvalidated.plans[1]));
+  EXPECT_GE(result.plans[0].cost, unvalidated.plans[1].cost);
+  EXPECT_EQ(offered, 4);
+
+  const ReportSources sources{"bracket.stl", "hybrid-3axis.yaml", machine.name, machine_text};
+  const fs::path dir = fs::temp_directory_path() / ("hybridctl-plan-rejected-" + std::to_string(::getpid()));
+  write_plan_directory(result, sources, dir);
+  const PlanFile disk = read_plan_file(dir);
+  fs::remove_all(dir);
+  const PlanFile memory = to_plan_file(result, sources, dir);
+  EXPECT_TRUE(memory == disk);
+  ASSERT_EQ(disk.rejected.size(), 2u);
+  EXPECT_EQ(disk.rejected[0].reasons, result.rejected[0].reasons);
+  EXPECT_EQ(disk.rejected[1].reasons, result.rejected[1].reasons);
+  EXPECT_EQ(disk.rejected[0].actions.size(), result.rejected[0].plan.steps.size());
+  EXPECT_NE(plan_summary(result, sources).find("2 candidates rejected"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace hybridctl::planner

@@ -170,6 +170,75 @@ TEST(Controller, ARapidIntoTheStockIsAnAlarm) {
   EXPECT_EQ(c.status().alarm_line, 6u);
 }
 
+// A plate 2 mm thick, a pillar 8 mm high on it at x [0, 10], and a post at the far corner
+// (so the simulated world reaches above the pillar), on the plan's 0.5 mm lattice.
+geometry::Solid pillar_stock() {
+  const geometry::Lattice l{0.5, {0, 0, 0}};
+  geometry::Solid s = geometry::make_box(l, {{0, 0, 0}, {40, 20, 2}});
+  s = geometry::unite(s, geometry::make_box(l, {{0, 0, 2}, {10, 20, 10}}));
+  return geometry::unite(s, geometry::make_box(l, {{38, 18, 2}, {40, 20, 20}}));
+}
+
+// The DED head (T100) lays one track on the pillar's top at z 10 from x 2 to x `to`.
+std::string track_program(double to) {
+  return "G21 G90\nG54\nT100 M6\nG0 X2 Y10 Z30\nG1 Z10 F800\nM64 P0\nG1 X" + std::to_string(to) +
+         " F800\nM65 P0\nG1 Z30 F800\nM2\n";
+}
+
+TEST(Controller, ABeadOverAirFallsAndTheControllerWarnsAndGoesOn) {
+  ControllerOptions o;
+  o.stock = pillar_stock();
+  // On the pillar only: no warning.
+  {
+    Controller c(machine(), o);
+    Host host(c, track_program(9));
+    host.command(CommandCode::SetProgram);
+    host.send_all();
+    host.command(CommandCode::Start);
+    c.advance(0.01);
+    EXPECT_EQ(c.status().state, ControllerState::Completed);
+    EXPECT_EQ(c.status().alarm, AlarmCode::None) << ::testing::PrintToString(c.report().alarms);
+  }
+  // Off its edge into the air: the bead beyond the cone falls, the warning names line 7,
+  // the program runs to its end.
+  Controller c(machine(), o);
+  Host host(c, track_program(20));
+  host.command(CommandCode::SetProgram);
+  host.send_all();
+  host.command(CommandCode::Start);
+  c.advance(0.01);
+  const protocol::Status s = c.status();
+  EXPECT_EQ(s.state, ControllerState::Completed);
+  EXPECT_EQ(s.alarm, AlarmCode::DepositionOverAir);
+  EXPECT_EQ(s.alarm_line, 7u);
+  EXPECT_EQ(s.last_executed_line, 10u);
+  const ControllerReport r = c.report();
+  ASSERT_EQ(r.alarms.size(), 1u);
+  EXPECT_NE(r.alarms[0].find("line 7: DEPOSITION_OVER_AIR (warning)"), std::string::npos) << r.alarms[0];
+  // Nothing was added beyond the pillar's edge plus the cone's reach (30 degrees: under a voxel
+  // per layer, with one voxel of slack).
+  const geometry::Solid added = geometry::subtract(c.as_built(), pillar_stock());
+  EXPECT_GT(added.volume(), 0);
+  EXPECT_LE(added.bounding_box_mm().max.x, 11.0);
+}
+
+TEST(Controller, TheNozzleTouchingMaterialIsACollisionAlarm) {
+  ControllerOptions o;
+  o.stock = pillar_stock();
+  Controller c(machine(), o);
+  // A track on the plate towards the post: the bead has room, but the 20 mm nozzle 10 mm
+  // above it meets the post (18 mm high) on the way.
+  Host host(c, "G21 G90\nG54\nT100 M6\nG0 X30 Y5 Z30\nG1 Z2 F800\nM64 P0\nG1 Y14 F800\nM65 P0\nM2\n");
+  host.command(CommandCode::SetProgram);
+  host.send_all();
+  host.command(CommandCode::Start);
+  c.advance(0.01);
+  EXPECT_EQ(c.status().state, ControllerState::Alarm);
+  EXPECT_EQ(c.status().alarm, AlarmCode::NozzleCollision);
+  EXPECT_EQ(c.status().alarm_line, 7u);
+  EXPECT_EQ(c.status().last_executed_line, 7u);
+}
+
 TEST(Controller, WithoutAHeartbeatTheMotionStops) {
   ControllerOptions o;
   o.time_scale = 1;

@@ -298,11 +298,16 @@ TEST(MaterialSimulation, ArcsCutWithinTheChordToleranceOfTheTrueArc) {
 const geometry::Lattice kFine{0.125, {0, 0, 0}};
 const IndexBox kPlateBox{{0, 0, 0}, {200, 64, 24}};  // 25 x 8 x 3 mm
 
+// The voxel of kFine holding a point (mm).
+geometry::Index3 voxel_at(double x, double y, double z) {
+  return {int(std::floor(x / kFine.voxel_size)), int(std::floor(y / kFine.voxel_size)), int(std::floor(z / kFine.voxel_size))};
+}
+
 TEST(MaterialSimulation, ABeadDepositsItsSweptVolume) {
   const double length = 20;
   {
     MaterialSimulation sim(Solid(kFine, kPlateBox));
-    const Bead bead{config::BeadShape::Ellipsoid, 2, 1, {}};
+    const Bead bead{config::BeadShape::Ellipsoid, 2, 1, {}, {}};
     const MoveReport r = sim.deposit(bead, {Motion::Linear, {2, 3, 0}, {2 + length, 3, 0}, {}, true, 50});
     // An elliptic cylinder with half an ellipsoid at each end.
     const double expected = std::numbers::pi * 1 * 0.5 * length + 4.0 / 3 * std::numbers::pi * 1 * 1 * 0.5;
@@ -319,7 +324,7 @@ TEST(MaterialSimulation, ABeadDepositsItsSweptVolume) {
   }
   {
     MaterialSimulation sim(Solid(kFine, kPlateBox));
-    const Bead bead{config::BeadShape::Cylinder, 2, 1, {}};
+    const Bead bead{config::BeadShape::Cylinder, 2, 1, {}, {}};
     const MoveReport r = sim.deposit(bead, {Motion::Linear, {2, 3, 0}, {2 + length, 3, 0}, {}, true, 51});
     const double expected = 2 * 1 * length + std::numbers::pi * 1 * 1 * 1;  // box with round ends
     EXPECT_NEAR(r.deposited, expected, 0.02 * expected);
@@ -327,7 +332,7 @@ TEST(MaterialSimulation, ABeadDepositsItsSweptVolume) {
 }
 
 TEST(MaterialSimulation, OverlapUnsupportedAndLostDepositionAreReported) {
-  const Bead bead{config::BeadShape::Ellipsoid, 2, 1, {}};
+  const Bead bead{config::BeadShape::Ellipsoid, 2, 1, {}, {}};
   MaterialSimulation sim(Solid(kFine, kPlateBox));
   const Segment first{{2, 3, 0}, {20, 3, 0}};
   sim.deposit(bead, {Motion::Linear, first.from, first.to, {}, true, 60});
@@ -341,12 +346,16 @@ TEST(MaterialSimulation, OverlapUnsupportedAndLostDepositionAreReported) {
   EXPECT_DOUBLE_EQ(r.deposited + r.overlap, second_bead.volume());
   EXPECT_TRUE(r.incidents.empty());
 
-  // Beside the wall, half a millimetre above the plate: nothing below.
-  const MoveReport air = sim.deposit(bead, {Motion::Linear, {2, 6, 0.5}, {20, 6, 0.5}, {}, true, 62});
+  // Beside the wall, half a millimetre above the plate: nothing below, so it all falls.
+  const Solid before = sim.stock();
+  const Segment over_air{{2, 6, 0.5}, {20, 6, 0.5}};
+  const MoveReport air = sim.deposit(bead, {Motion::Linear, over_air.from, over_air.to, {}, true, 62});
   ASSERT_EQ(air.incidents.size(), 1u);
   EXPECT_EQ(air.incidents.front().kind, IncidentKind::UnsupportedDeposition);
   EXPECT_EQ(air.incidents.front().line, 62);
-  EXPECT_DOUBLE_EQ(air.incidents.front().volume, air.deposited);
+  EXPECT_EQ(air.deposited, 0);
+  EXPECT_DOUBLE_EQ(air.incidents.front().volume, swept_volume(pieces_of(bead), over_air, kFine, kPlateBox).volume());
+  EXPECT_EQ(sim.stock(), before);
 
   // Running along the domain's side at y = 8 mm: the bead's outer half is lost.
   const Segment edge{{15, 7.5, 0}, {20, 7.5, 0}};
@@ -359,8 +368,70 @@ TEST(MaterialSimulation, OverlapUnsupportedAndLostDepositionAreReported) {
   EXPECT_NEAR(lost.incidents.back().region.max.y, 8.5, 1e-12);
 }
 
+TEST(MaterialSimulation, ABeadOffAnEdgeKeepsWhatTheHeadsConeHoldsAndTheRestFalls) {
+  // A block 10 mm long, 2 mm high; a cylinder bead 1 mm wide laid on its top from x 2 to 20.
+  const Solid block = geometry::make_box(kFine, {{0, 0, 0}, {10, 8, 2}});
+  Solid world(kFine, kPlateBox);
+  world = geometry::unite(world, block);
+  Bead bead{config::BeadShape::Cylinder, 1, 0.5, {}, {}};
+  bead.support = {45, 0};
+  MaterialSimulation sim(world);
+  const MoveReport r = sim.deposit(bead, {Motion::Linear, {2, 4, 2}, {20, 4, 2}, {}, true, 80});
+  ASSERT_EQ(count_of(r.incidents, IncidentKind::UnsupportedDeposition), 1);
+  // Held: on the block and up to the cone's reach beyond its edge (tan 45 + 1 voxel of
+  // slack = 2 voxels of 0.125 mm); what fell starts there and runs to the bead's end.
+  const Solid added = geometry::subtract(sim.stock(), world);
+  EXPECT_NEAR(added.bounding_box_mm().max.x, 10.25, 1e-9);
+  const Incident& fell = r.incidents.front();
+  EXPECT_NEAR(fell.region.min.x, 10.25, 1e-9);
+  EXPECT_NEAR(fell.region.max.x, 20.5, 1e-9);
+  EXPECT_DOUBLE_EQ(r.deposited + fell.volume, swept_volume(pieces_of(bead), {{2, 4, 2}, {20, 4, 2}}, kFine, kPlateBox).volume());
+}
+
+TEST(MaterialSimulation, ABeadBridgesAGapWithinTheHeadsSpanOnly) {
+  // Two blocks with a gap between them; a bead across it on their tops.
+  auto gap_world = [](double gap) {
+    Solid w(kFine, kPlateBox);
+    w = geometry::unite(w, geometry::make_box(kFine, {{0, 0, 0}, {5, 8, 2}}));
+    return geometry::unite(w, geometry::make_box(kFine, {{5 + gap, 0, 0}, {12 + gap, 8, 2}}));
+  };
+  Bead bead{config::BeadShape::Cylinder, 1, 0.5, {}, {}};
+  bead.support = {0, 2};  // no overhang; bridges up to 2 mm
+  for (const double gap : {1.5, 3.0}) {
+    SCOPED_TRACE(gap);
+    MaterialSimulation sim(gap_world(gap));
+    const MoveReport r = sim.deposit(bead, {Motion::Linear, {1, 4, 2}, {10 + gap, 4, 2}, {}, true, 90});
+    const bool spans = gap - 2 * 0.125 <= 2;  // the cone's slack holds one voxel at each edge
+    EXPECT_EQ(count_of(r.incidents, IncidentKind::UnsupportedDeposition), spans ? 0 : 1);
+    EXPECT_EQ(sim.stock().contains(voxel_at(5 + gap / 2, 4, 2.1)), spans);
+  }
+}
+
+TEST(MaterialSimulation, TheHeadsNozzleStandsOffAndCollidesWithWhatItMeets) {
+  config::AdditiveHead head;
+  head.bead = {config::BeadShape::Cylinder, 1, 0.5};
+  head.nozzle = config::Nozzle{4, 10, 2};
+  const Bead bead = bead_of(head);
+  ASSERT_EQ(bead.body.size(), 1u);
+  EXPECT_EQ(bead.body[0].from, 2);
+  EXPECT_EQ(bead.body[0].to, 12);
+  // A wall 2.5 mm high beside a track on the plate: the bead passes 1 mm from it, the
+  // nozzle (radius 2, from 2 mm up) meets its top half millimetre.
+  Solid world(kFine, kPlateBox);
+  world = geometry::unite(world, geometry::make_box(kFine, {{0, 5, 0}, {25, 8, 2.5}}));
+  MaterialSimulation sim(world);
+  const MoveReport r = sim.deposit(bead, {Motion::Linear, {2, 4, 0}, {20, 4, 0}, {}, true, 100});
+  ASSERT_EQ(count_of(r.incidents, IncidentKind::BodyCollision), 1);
+  EXPECT_NEAR(r.incidents.front().region.min.z, 2, 1e-9);
+  // Beside a wall lower than the stand-off, nothing touches.
+  Solid low(kFine, kPlateBox);
+  low = geometry::unite(low, geometry::make_box(kFine, {{0, 5, 0}, {25, 8, 1.5}}));
+  MaterialSimulation clear(low);
+  EXPECT_TRUE(clear.deposit(bead, {Motion::Linear, {2, 4, 0}, {20, 4, 0}, {}, true, 101}).incidents.empty());
+}
+
 TEST(MaterialSimulation, HeadTravelChecksRapidsAgainstMaterial) {
-  const Bead bead{config::BeadShape::Ellipsoid, 2, 1, {}};
+  const Bead bead{config::BeadShape::Ellipsoid, 2, 1, {}, {}};
   MaterialSimulation sim(Solid(kFine, kPlateBox));
   sim.deposit(bead, {Motion::Linear, {2, 3, 0}, {20, 3, 0}, {}, true, 70});
   // Feed without deposition over the bead: the melt zone is no body, nothing to report.

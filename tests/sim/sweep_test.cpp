@@ -83,8 +83,8 @@ TEST(SweptVolume, AxisAlignedMovesEqualTheDilationOfTheirPath) {
 
 TEST(SweptVolume, LevelBeadMovesEqualTheDilationOfTheirPath) {
   // Ellipsoid 2 x 1 mm: centre 0.5 mm = one voxel above the programmed (bottom) point.
-  const Bead ellipsoid{config::BeadShape::Ellipsoid, 2.0, 1.0, {}};
-  const Bead cylinder{config::BeadShape::Cylinder, 2.5, 1.5, {}};
+  const Bead ellipsoid{config::BeadShape::Ellipsoid, 2.0, 1.0, {}, {}};
+  const Bead cylinder{config::BeadShape::Cylinder, 2.5, 1.5, {}, {}};
   for (const auto& [a, b] : std::vector<std::pair<geometry::Index3, geometry::Index3>>{
            {{2, 4, 3}, {15, 4, 3}}, {{3, 15, 0}, {3, 2, 0}}, {{7, 7, 7}, {7, 7, 7}}}) {
     const Solid path = path_voxels(a, b);
@@ -151,7 +151,7 @@ TEST(SweptVolume, AnySegmentLiesBetweenDensePlacementsOfTheTool) {
 }
 
 TEST(SweptVolume, AnyBeadSegmentLiesBetweenDensePlacementsOfTheBead) {
-  const Bead bead{config::BeadShape::Ellipsoid, 2.2, 1.3, {}};
+  const Bead bead{config::BeadShape::Ellipsoid, 2.2, 1.3, {}, {}};
   for (const auto& [a, b] : general_segments()) {
     const Solid got = swept_volume(pieces_of(bead), {a, b}, kLattice, kDomain);
     expect_between_dense_placements(
@@ -177,7 +177,7 @@ TEST(SweptVolume, BadSectionsAreRejected) {
   const double inf = std::numeric_limits<double>::infinity();
   EXPECT_THROW(pieces_of(std::vector<AxialSection>{{Kind::Sphere, 0, inf, 1, 1, 0}}), std::invalid_argument);
   EXPECT_THROW(pieces_of(std::vector<AxialSection>{{Kind::Cylinder, 0, 1, -1, 0, 0}}), std::invalid_argument);
-  EXPECT_THROW(pieces_of(Bead{config::BeadShape::Ellipsoid, 0, 1, {}}), std::invalid_argument);
+  EXPECT_THROW(pieces_of(Bead{config::BeadShape::Ellipsoid, 0, 1, {}, {}}), std::invalid_argument);
   // An empty section (from > to) is dropped; a zero-ring torus is a sphere.
   EXPECT_TRUE(pieces_of(std::vector<AxialSection>{{Kind::Cylinder, 2, 1, 1, 0, 0}}).empty());
   EXPECT_EQ(pieces_of(std::vector<AxialSection>{{Kind::Torus, 0, 1, 1, 1, 0}}).front().kind, ConvexPiece::Kind::Sphere);

@@ -139,7 +139,7 @@ TEST(DepositionPath, SegmentsLieInTheirLayersRegion) {
   const auto head = ded_head();
   const Toolpath p = deposition_path(roi, base, head, top_setup());
   expect_segments_in_region(p, roi, head.layer_height);
-  EXPECT_FALSE(has_warning(p, "overhang"));
+  EXPECT_FALSE(has_warning(p, "overhang")) << (p.warnings.empty() ? "" : p.warnings.front());
 }
 
 TEST(DepositionPath, ContourPassesStayInTheRegionToo) {
@@ -182,10 +182,12 @@ TEST(DepositionPath, LayersGoBottomUpAtTheLayerHeight) {
 TEST(DepositionPath, EveryVoxelLayerOfTheRoiBelongsToADepositionLayer) {
   // 0.6 mm layers on 0.5 mm voxels: the band [1.2, 1.8) holds the centres of voxel layers
   // 2 and 3. A flange one voxel thick in layer 2 (z 1.0..1.5) must be deposited with that
-  // band, not lost between the voxel layers the bands' middles fall in.
+  // band, not lost between the voxel layers the bands' middles fall in. It rests on existing
+  // material around the core (a flange over air would not be laid).
   const Solid roi = geometry::unite(box({{4, 4, 0}, {12, 12, 2}}), box({{0, 0, 1}, {16, 16, 1.5}}));
+  const Solid under_flange = geometry::subtract(box({{0, 0, 0}, {16, 16, 1}}), box({{4, 4, 0}, {12, 12, 1}}));
   const auto head = ded_head();
-  const Toolpath p = deposition_path(roi, Solid(kLattice, {}), head, top_setup());
+  const Toolpath p = deposition_path(roi, under_flange, head, top_setup());
   expect_segments_in_region(p, roi, head.layer_height);
   double flange = 0;  // mm of deposition outside the core's footprint
   for (const auto& s : deposition_segments(p))
@@ -326,7 +328,7 @@ TEST(DepositionPath, TravelLiftsByTheClearanceOverWhatIsBelow) {
   EXPECT_GT(lifts, 5);
 }
 
-TEST(DepositionPath, OverhangsAreReported) {
+TEST(DepositionPath, OverhangsAreNotLaidAndAreReported) {
   const auto head = ded_head();
   // A block on the plate (the lowest material) is supported; so is one on existing
   // material; a block in mid-air beside them is not.
@@ -338,10 +340,13 @@ TEST(DepositionPath, OverhangsAreReported) {
   EXPECT_FALSE(has_warning(p2, "overhang")) << (p2.warnings.empty() ? "" : p2.warnings.front());
   const Toolpath p3 = deposition_path(box({{14, 2, 5}, {20, 8, 7}}), base, head, top_setup());
   ASSERT_TRUE(has_warning(p3, "overhang"));
-  // Only the first layer floats: later ones sit on it.
+  EXPECT_TRUE(has_warning(p3, "not deposited"));
+  // A bead over air falls: nothing of the floating block is laid, and each of its layers,
+  // with nothing under it, says so.
+  EXPECT_TRUE(deposition_segments(p3).empty());
   int overhang_warnings = 0;
   for (const auto& w : p3.warnings) overhang_warnings += w.find("overhang") != std::string::npos;
-  EXPECT_EQ(overhang_warnings, 1);
+  EXPECT_EQ(overhang_warnings, 3);  // its four voxel layers fall in three bands of 0.6 mm
   // An explicit build plate below a floating block.
   DepositionOptions o;
   o.build_plate_z = 0;
@@ -353,6 +358,11 @@ TEST(DepositionPath, OverhangsAreReported) {
   // A ledge wider than its support by more than half a bead overhangs at its edge.
   const Toolpath p6 = deposition_path(box({{0, 0, 3}, {14, 10, 5}}), base, head, top_setup());
   EXPECT_TRUE(has_warning(p6, "overhang"));
+  // The ledge is laid up to the head's reach beyond its support, not farther.
+  double farthest = 0;
+  for (const auto& s : deposition_segments(p6)) farthest = std::max({farthest, s.a.x, s.b.x});
+  EXPECT_GT(farthest, 9.0);
+  EXPECT_LT(farthest, 11.0);  // the ledge itself runs to 14
 }
 
 TEST(DepositionPath, RegionsNarrowerThanABeadAreDroppedWithAWarning) {
@@ -373,7 +383,14 @@ TEST(DepositionPath, RoiUnderExistingMaterialIsSkipped) {
   const Solid roi = box({{2, 2, 1}, {18, 8, 3}});
   const auto head = ded_head();
   const Toolpath p = deposition_path(roi, existing, head, top_setup());
-  EXPECT_TRUE(has_warning(p, "under existing material"));
+  // A defect, not a warning: the part would lack that deposit (export refuses the plan).
+  EXPECT_FALSE(has_warning(p, "under existing material"));
+  ASSERT_FALSE(p.defects.empty());
+  for (const gcode::PathDefect& d : p.defects) {
+    EXPECT_EQ(d.kind, "layer_skipped");
+    EXPECT_NE(d.message.find("under existing material"), std::string::npos) << d.message;
+    EXPECT_NEAR(d.where.x, 10, 1.5) << "the middle of the bridged columns";
+  }
   for (const auto& s : deposition_segments(p))
     along(s.a, s.b, 0.05, [&](Vec3 q) { EXPECT_FALSE(q.x > 8.01 && q.x < 11.99) << q.x; });
 }

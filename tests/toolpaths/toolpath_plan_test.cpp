@@ -1,6 +1,6 @@
-// Toolpaths for a real plan: the bundled bracket on the bundled hybrid machine, planned
+// Toolpaths for a real plan: the bundled flanged hub on the bundled hybrid machine, planned
 // at a coarse 1 mm voxel so that the test stays quick. Every action of a hybrid plan
-// (raw stock, milling from below and from above, deposition) gets its toolpath; milling
+// (deposition from above and from below, milling) gets its toolpath; milling
 // never puts the tool (cutter, shank, holder) where it would touch what the action keeps,
 // checked at 1/8-voxel steps against the allowed region computed here from the planner's
 // own instrument; deposition stays in its region.
@@ -25,13 +25,17 @@ namespace {
 using geometry::Solid;
 using geometry::Vec3;
 
-TEST(ToolpathsForAPlan, BracketOnTheHybridMachine) {
+TEST(ToolpathsForAPlan, FlangedHubOnTheHybridMachine) {
   const config::Machine machine = config::load_machine(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
-  const geometry::TriangleMesh part = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/bracket.stl");
+  const geometry::TriangleMesh part = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/flanged-hub.stl");
   planner::PlanningOptions options;
   options.voxel_size = 1.0;
-  options.top_k = 8;
-  const planner::PlanningResult r = planner::plan_part(part, "bracket", machine, options);
+  options.top_k = 16;
+  // Not validated by execution (the planner alone): the subject is each action's toolpath
+  // against its region, not whether the plan makes the part. The hub's plans that pass
+  // execution only mill (plate, then -Z and +Z); the first that mills and deposits is
+  // plan 14, deposit from +Z, mill, deposit from -Z.
+  const planner::PlanningResult r = planner::plan_part(part, "flanged-hub", machine, options);
   // The first plan that mills and deposits.
   const planner::Plan* plan = nullptr;
   for (const auto& p : r.plans) {

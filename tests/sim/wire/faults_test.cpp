@@ -272,10 +272,49 @@ TEST(SimServe, WritesTheAsBuiltStockOfAVdbStock) {
   fs::remove_all(dir);
 }
 
+TEST(SimServe, ABeadOverAirIsAWarningOnTheWireAndTheProgramGoesOn) {
+  const fs::path dir = temp_dir("over-air");
+  // A plate, a pillar 8 mm high at x [0, 10], and a post at the far corner so the simulated
+  // world reaches above the pillar; the DED head (T100) lays a track on the pillar's top
+  // from x 2 and on past its edge into the air to x 20 (line 7).
+  const geometry::Lattice lattice{0.5, {0, 0, 0}};
+  geometry::Solid stock = geometry::Solid::filled(lattice, geometry::IndexBox{{0, 0, 0}, {80, 40, 4}});
+  stock = geometry::unite(stock, geometry::Solid::filled(lattice, geometry::IndexBox{{0, 0, 4}, {20, 40, 20}}));
+  stock = geometry::unite(stock, geometry::Solid::filled(lattice, geometry::IndexBox{{76, 36, 4}, {80, 40, 40}}));
+  geometry::write_vdb(stock, dir / "stock.vdb");
+  SimProcess sim(serve_args({"--exit-when-done", "--stock-vdb", (dir / "stock.vdb").string(), "--as-built",
+                             (dir / "built.vdb").string(), "--report", (dir / "run.json").string()}));
+  ModbusClient client(sim.modbus_port());
+  Host host(client, {"G21 G90", "G54", "T100 M6", "G0 X2 Y10 Z30", "G1 Z10 F800", "M64 P0", "G1 X20 F800", "M65 P0",
+                     "G1 Z30 F800", "M2"});
+  ASSERT_EQ(host.command(CommandCode::SetProgram), ResultCode::Accepted);
+  ASSERT_TRUE(host.send_program());
+  ASSERT_EQ(host.command(CommandCode::Start), ResultCode::Accepted);
+  const auto s = host.wait([](const protocol::Status& st) { return st.state == ControllerState::Completed; });
+  ASSERT_TRUE(s.has_value()) << "the program runs to its end";
+  EXPECT_EQ(s->alarm, AlarmCode::DepositionOverAir);
+  EXPECT_EQ(s->alarm_line, 7u);
+  ASSERT_EQ(sim.wait(10s), 0) << sim.errors();
+  const json report = read_json(dir / "run.json");
+  ASSERT_EQ(report["alarms"].size(), 1u) << report["alarms"];
+  EXPECT_EQ(report["alarms"][0].get<std::string>().rfind("line 7: DEPOSITION_OVER_AIR (warning): line 7: unsupported deposition", 0), 0u)
+      << report["alarms"];
+  // What lies over air beyond the pillar's edge (and the cone's reach) was not added.
+  const geometry::Solid added = geometry::subtract(geometry::read_vdb(dir / "built.vdb"), stock);
+  EXPECT_GT(added.volume(), 0);
+  EXPECT_LE(added.bounding_box_mm().max.x, 11.0);
+  fs::remove_all(dir);
+}
+
 TEST(SimServe, TakesTheStockFromAPlan) {
   const fs::path dir = temp_dir("plan-stock");
-  const PeerResult plan = run_peer({HYBRIDCTL_EXE, "plan", std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/bracket.stl",
-                                    "--machine", example_machine(), "--voxel", "1", "-o", (dir / "plan").string()});
+  // --no-validate: the subject is the stock `sim serve --stock` takes from a plan's first
+  // action, not whether the plan makes the part. The flanged hub's plans that pass
+  // execution all start from a raw stock; unvalidated, its 6th plan at 1 mm deposits from
+  // nothing.
+  const PeerResult plan = run_peer({HYBRIDCTL_EXE, "plan", std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/flanged-hub.stl",
+                                    "--machine", example_machine(), "--voxel", "1", "--top", "6", "--no-validate", "-o",
+                                    (dir / "plan").string()});
   ASSERT_EQ(plan.exit_code, 0) << plan.output;
   // The ranks of a plan that starts from a raw stock and of one that starts by depositing.
   const json plans = read_json(dir / "plan" / "plan.json");
@@ -287,7 +326,8 @@ TEST(SimServe, TakesTheStockFromAPlan) {
     int& rank = raw ? from_stock : from_nothing;
     if (rank == 0) rank = p["rank"];
   }
-  ASSERT_GT(from_stock, 0) << "the bracket's plans should include one from a raw stock";
+  ASSERT_GT(from_stock, 0) << "the flanged hub's plans should include one from a raw stock";
+  ASSERT_GT(from_nothing, 0) << "the flanged hub's plans should include one that starts by depositing";
   const geometry::Solid design = geometry::read_vdb(dir / "plan" / "design.vdb");
 
   auto serve_plan = [&](int rank, json& report, geometry::Solid& built) {
@@ -303,11 +343,9 @@ TEST(SimServe, TakesTheStockFromAPlan) {
   EXPECT_EQ(report["stock"].get<std::string>().rfind("raw stock ", 0), 0u) << report["stock"];
   EXPECT_GT(built.volume(), design.volume()) << "the raw stock holds the part";
   EXPECT_NEAR(report["volumes_mm3"]["as_built"].get<double>(), built.volume(), 1e-6);
-  if (from_nothing > 0) {
-    serve_plan(from_nothing, report, built);
-    EXPECT_EQ(report["stock"].get<std::string>().rfind("empty", 0), 0u) << report["stock"];
-    EXPECT_EQ(built.volume(), 0.0) << "a plan that starts by depositing starts from nothing";
-  }
+  serve_plan(from_nothing, report, built);
+  EXPECT_EQ(report["stock"].get<std::string>().rfind("empty", 0), 0u) << report["stock"];
+  EXPECT_EQ(built.volume(), 0.0) << "a plan that starts by depositing starts from nothing";
   fs::remove_all(dir);
 }
 

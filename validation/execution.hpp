@@ -1,0 +1,109 @@
+#pragma once
+// A plan proven by execution (docs/validation.md): its actions are turned into toolpaths
+// one after the other, each planned against the material really present after the ones
+// before it, and the whole plan's program, as export writes it, is executed on the
+// simulated machine (sim::ProgramExecutor: interpreter, envelope, interlocks, material)
+// from the raw stock through every action in order. What comes out is the program, the
+// part as built, what went wrong on the way, and the located reasons why the plan does
+// not make the part, if any.
+//
+//   const validation::Execution run = validation::execute_plan(file, file.plans[0], machine);
+//   if (!run.proven()) for (const auto& r : run.reasons) ... planner::describe(r) ...
+//
+// This library sits above the planner, toolpaths and sim (docs/architecture.md): the
+// planner offers it candidates through PlanningOptions::validate (validation/plan_validator.hpp).
+
+#include <string>
+#include <vector>
+
+#include "common/error.hpp"
+#include "config/machine.hpp"
+#include "gcode/program.hpp"
+#include "geometry/solid.hpp"
+#include "planner/deviation.hpp"
+#include "planner/plan_file.hpp"
+#include "planner/rejection.hpp"
+#include "sim/material.hpp"
+#include "toolpaths/plan_export.hpp"
+
+namespace hybridctl::validation {
+
+// A plan that does not make its part: executing it found located reasons. Nothing is
+// written or streamed; the CLI maps it to exit code 4, as for a part that is not
+// manufacturable.
+class NotManufacturableError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
+// What each action's toolpath is planned against.
+enum class PlannedAgainst {
+  MaterialPresent,  // the stock the simulation holds after the actions before it (export, run, plan)
+  PlannedState,     // the plan's planned state (the export before validation; for comparison)
+};
+
+// How far a plan is executed once something goes wrong.
+enum class RunUntil {
+  End,                 // every action: every reason (export, run, dry-run)
+  FirstFailingAction,  // the end of the first action with a path defect, an incident or a refused line: enough to
+                       // reject a candidate (plan's validation), and much cheaper
+};
+
+struct ExecutionOptions {
+  toolpaths::ExportOptions export_options;  // generators and post-processor (dialect, name)
+  sim::SimulationOptions simulation;
+  PlannedAgainst planned_against = PlannedAgainst::MaterialPresent;
+  RunUntil run_until = RunUntil::End;
+};
+
+struct Execution {
+  toolpaths::PlanExport exported;      // toolpaths planned against the material present (when stopped early:
+                                       // the actions made, without their solids)
+  gcode::PostedProgram program;        // the whole plan's program, as export writes it
+  geometry::Solid as_built;            // part frame, the plan's lattice and domain
+  sim::SimulationReport report;        // incidents carry the program's lines
+  std::vector<std::string> errors;     // lines the machine refused (G-code, envelope, interlocks)
+  planner::Deviation deviation;        // as built against the design
+  std::vector<planner::RejectionReason> reasons;  // empty: the plan makes the part
+  int stopped_after = 0;  // RunUntil::FirstFailingAction: the action it stopped after (0: ran to the end)
+  bool proven() const { return reasons.empty(); }
+};
+
+// Exports and executes `plan` of `file` on `machine` from its raw stock (an empty stock on
+// the plan's domain when it starts with deposition). Each action's lines spare what the
+// action keeps of the design, shrunk by the tolerance (planner::spared_by_cuts; a cut into
+// it is a gouge): a removal's own region may take design material a later deposit builds
+// again, and the deviation judges the part as built. Throws
+// InputError when an action cannot be written for the machine (another machine, an
+// instrument it lacks, a move beyond its envelope), as toolpaths::export_plan and
+// gcode::post_program do.
+Execution execute_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+                       const ExecutionOptions& options = {});
+
+// The reasons of an execution, as execute_plan fills `reasons`: the toolpaths' defects
+// (layer skipped, region unreachable), every incident kind per action (rapid into
+// material, body collision, gouge, unsupported deposit, ...), refused lines, and the part
+// as built outside the tolerance (missing or excess material).
+std::vector<planner::RejectionReason> rejection_reasons(const Execution& execution, const planner::PlanFile& file,
+                                                        const config::Machine& machine);
+
+// plan.json's name for an incident kind ("rapid_into_material", "body_collision", ...).
+std::string reason_kind(sim::IncidentKind kind);
+
+// The reasons as lines for people, at most `shown` of them and a count of the rest.
+std::string describe_reasons(const std::vector<planner::RejectionReason>& reasons, std::size_t shown = 20);
+
+// Whether a reason stops export and run from writing or streaming the plan: path defects
+// (layer_skipped, unreachable), rapids and bodies into material, gouges, refused lines.
+// Deposit over air and a part out of tolerance reject candidates in `plan` but are
+// warnings for a plan given to export (the machine answers a bead over air with a warning
+// alarm).
+bool refuses_output(const planner::RejectionReason& reason);
+
+// execute_plan, and a NotManufacturableError (exit 4) naming `what` ("plan 2 (expr)") and
+// every reason when a reason refuses output: export and run write or stream nothing then.
+// The other reasons stay in the execution's `reasons` for the caller to warn about.
+Execution require_proven(const planner::PlanFile& file, const planner::PlanFilePlan& plan,
+                         const config::Machine& machine, const ExecutionOptions& options, const std::string& what);
+
+}  // namespace hybridctl::validation

@@ -1,0 +1,29 @@
+#pragma once
+// Validation by execution as the planner's hook (PlanningOptions::validate): every
+// candidate plan the search finds is exported and executed (validation/execution.hpp)
+// before it is offered; its reasons, if any, reject it and the search goes on.
+//
+//   planner::PlanningOptions options;
+//   options.validate = validation::plan_validator(machine);
+//   const planner::PlanningResult r = planner::plan_part(mesh, name, machine, options);
+//   // r.plans: proven; r.rejected: the candidates that failed, with their reasons
+
+#include <functional>
+#include <vector>
+
+#include "config/machine.hpp"
+#include "planner/planning.hpp"
+#include "validation/execution.hpp"
+
+namespace hybridctl::validation {
+
+using PlanCheck = std::function<std::vector<planner::RejectionReason>(const planner::PlanningResult&, const planner::Plan&)>;
+
+// The hook. It keeps `machine` by reference (it must outlive planning) and turns the
+// planning result into a plan file (planner::to_plan_file) once, at the first candidate.
+PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions options = {});
+
+// One candidate of a planning result as the plan file names it (rank 0).
+planner::PlanFilePlan candidate_plan(const planner::PlanningResult& result, const planner::Plan& plan);
+
+}  // namespace hybridctl::validation
