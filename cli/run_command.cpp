@@ -85,8 +85,11 @@ class TerminalOperator : public drivers::JobOperator {
     if (std::chrono::duration<double>(Clock::now() - last_print_).count() < every) return;
     last_print_ = Clock::now();
     char buf[256];
-    std::snprintf(buf, sizeof buf, "action %zu/%zu  line %u/%zu  %3.0f%%  ETA %s  %-12s  X%.3f Y%.3f Z%.3f  T%u", p.action,
-                  p.actions, s.last_executed_line, p.lines, p.done * 100, gcode::format_duration(p.eta_s).c_str(),
+    // The plan's action number, as the program's headings and the final report give it, and
+    // how far through the program's actions that is (a raw stock action has no lines).
+    const std::string action = p.action_number > 0 ? std::to_string(p.action_number) : std::string("-");
+    std::snprintf(buf, sizeof buf, "action %s (%zu/%zu)  line %u/%zu  %3.0f%%  ETA %s  %-12s  X%.3f Y%.3f Z%.3f  T%u",
+                  action.c_str(), p.action, p.actions, s.last_executed_line, p.lines, p.done * 100, gcode::format_duration(p.eta_s).c_str(),
                   std::string(protocol::to_string(s.state)).c_str(), s.x_um / 1000.0, s.y_um / 1000.0, s.z_um / 1000.0,
                   unsigned(s.active_tool));
     const std::string waiting = waiting_for(s);

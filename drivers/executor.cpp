@@ -146,11 +146,14 @@ class ActionTracker {
       s.first = table[i].first_line;
       s.last = i + 1 < table.size() ? table[i + 1].first_line - 1 : std::uint32_t(program.lines.size());
       s.name = table[i].heading();
+      s.number = table[i].number;
       spans_.push_back(std::move(s));
     }
   }
 
   std::size_t size() const { return spans_.size(); }
+  // The plan's number of the 1-based `action`; 0 for none.
+  int number(std::size_t action) const { return action == 0 ? 0 : spans_[action - 1].number; }
 
   void seen(const protocol::Status& s, Clock::time_point now) {
     for (auto& a : spans_) {
@@ -205,6 +208,7 @@ class ActionTracker {
   struct Span {
     std::uint32_t first = 0, last = 0;  // program lines
     std::string name;
+    int number = 0;  // the plan's action number
     std::optional<Clock::time_point> started, finished;
     std::vector<std::string> alarms;
   };
@@ -231,6 +235,7 @@ StreamCallbacks stream_callbacks(JobOperator& op, ActionTracker& actions, const 
     JobProgress p;
     p.action = actions.current(s);
     p.actions = actions.size();
+    p.action_number = actions.number(p.action);
     p.lines = lines.size();
     p.done = lines.empty() ? 1 : double(s.last_executed_line) / double(lines.size());
     p.eta_s = p.done > 0.01 ? seconds_between(begun, now) * (1 - p.done) / p.done : 0;

@@ -63,7 +63,8 @@ struct JobStart {
 /// Where the stream is, at every status read.
 struct JobProgress {
   std::size_t action = 0;   ///< 1-based action the next line belongs to; 0 before the first
-  std::size_t actions = 0;
+  std::size_t actions = 0;  ///< actions in the program (a plan's raw stock has none)
+  int action_number = 0;    ///< that action's number in the plan, as its heading and the final report say; 0 before
   std::size_t lines = 0;
   double done = 0;          ///< fraction of the lines executed
   double eta_s = 0;         ///< from the rate so far; 0 until 1 % is done

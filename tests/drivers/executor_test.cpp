@@ -34,7 +34,9 @@ struct RecordingOperator : drivers::JobOperator {
   void progress(const protocol::Status&, const drivers::JobProgress& p) override {
     ++progress_calls;
     EXPECT_LE(p.action, p.actions);
+    seen_actions.emplace_back(p.action, p.action_number);
   }
+  std::vector<std::pair<std::size_t, int>> seen_actions;  // (index in the program, the plan's number)
   std::vector<std::string> notes;
   void note(const std::string& n) override { notes.push_back(n); }
   bool continue_after_stop(const protocol::Status&, const std::string& message) override {
@@ -54,8 +56,11 @@ std::string write_file(const fs::path& path, const std::string& text) {
 TEST(Executor, AProgramFileReportsPerActionFromItsHeadings) {
   const std::string machine_file = test::example_machine();
   const config::Machine machine = config::load_machine(machine_file);
-  const auto actions = gcode::samples::sample_actions(machine);
+  // Numbered from 2, as a plan whose first action is its raw stock (no lines) numbers them.
+  auto actions = gcode::samples::sample_actions(machine);
+  for (auto& a : actions) a.action += 1;
   const gcode::PostedProgram posted = gcode::post_program(actions, machine);
+  ASSERT_EQ(posted.actions.front().number, 2);
   const fs::path dir = test::scratch_dir("executor-headings");
   test::SimProcess sim({"--machine", machine_file, "--modbus", "tcp://127.0.0.1:0", "--time-scale", "0", "--exit-when-done"});
 
@@ -72,6 +77,9 @@ TEST(Executor, AProgramFileReportsPerActionFromItsHeadings) {
   EXPECT_EQ(op.job->lines, posted.lines.size());
   EXPECT_EQ(result.lines, posted.lines.size());
   EXPECT_GT(op.progress_calls, 0);
+  // The progress names each action by the plan's number, as its heading does.
+  for (const auto& [index, number] : op.seen_actions)
+    EXPECT_EQ(number, index == 0 ? 0 : posted.actions[index - 1].number) << "action " << index;
   // The setup change stops for the operator with its message.
   ASSERT_EQ(op.stop_messages.size(), 1u);
   EXPECT_EQ(op.stop_messages[0].rfind("MSG, setup bottom", 0), 0u) << op.stop_messages[0];
