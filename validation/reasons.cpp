@@ -71,16 +71,24 @@ void add_incidents(const Execution& run, const config::Machine& machine, std::ve
 void add_deviation(const Execution& run, double tolerance, std::vector<RejectionReason>& out) {
   const planner::Deviation& d = run.deviation;
   if (d.within_tolerance) return;
-  if (d.worst_under > tolerance)
+  // The two-sided test that decides `within_tolerance` (planner/deviation.hpp) names the
+  // reasons: a fin left out leaves few voxels empty, none deep, yet the design's surface at
+  // its tip is far from the part made.
+  if (d.worst_missing > tolerance)
     out.push_back({"missing_material", 0, 0,
-                   "as built, " + fixed_number(d.under_volume, 1) + " mm^3 of the design is missing, as deep as " +
-                       fixed_number(d.worst_under, 2) + " mm; tolerance " + trimmed_number(tolerance, 3) + " mm",
-                   std::nullopt});
-  if (d.worst_over > tolerance)
+                   "as built, " + fixed_number(d.under_volume, 1) +
+                       " mm^3 of the design is missing; the design's surface lies up to " +
+                       fixed_number(d.worst_missing, 2) + " mm from the part made; tolerance " +
+                       trimmed_number(tolerance, 3) + " mm",
+                   d.worst_missing_at});
+  if (d.worst_out > tolerance)
     out.push_back({"excess_material", 0, 0,
-                   "as built, " + fixed_number(d.over_volume, 1) + " mm^3 of material lies outside the design, as far as " +
-                       fixed_number(d.worst_over, 2) + " mm; tolerance " + trimmed_number(tolerance, 3) + " mm",
-                   std::nullopt});
+                   "as built, " + fixed_number(d.over_volume, 1) +
+                       " mm^3 of material lies outside the design; the part's surface (or a hole the design does not "
+                       "have) lies up to " +
+                       fixed_number(d.worst_out, 2) + " mm from the design's; tolerance " + trimmed_number(tolerance, 3) +
+                       " mm",
+                   d.worst_out_at});
 }
 
 }  // namespace

@@ -149,6 +149,23 @@ TEST(Execution, AMissingFeatureIsMissingMaterial) {
   EXPECT_FALSE(run.deviation.within_tolerance);
 }
 
+// A fin thinner than twice the tolerance, left out: none of its voxels is deep inside the
+// design, yet its tip is 8 mm from the part made. The reason says how far, and where.
+TEST(Execution, AThinFinLeftOutIsMissingMaterialAtItsTip) {
+  Case c(1.0);
+  const Solid plate = c.box({{5, 5, 0}, {25, 25, 4}});
+  c.file.design = unite(plate, c.box({{14, 7, 4}, {15, 23, 12}}));  // 1 mm thick, 8 mm tall
+  const Execution run = execute_plan(c.file, c.plan({c.deposit(plate)}), machine());
+  const planner::RejectionReason* r = first_of(run, "missing_material");
+  ASSERT_NE(r, nullptr) << all_reasons(run);
+  const auto at = r->message.find("lies up to ");
+  ASSERT_NE(at, std::string::npos) << r->message;
+  EXPECT_GT(std::stod(r->message.substr(at + 11)), 7.0) << r->message;  // the tip, 8 mm up, within a voxel
+  ASSERT_TRUE(r->where);
+  EXPECT_NEAR(r->where->x, 14.5, 1.0);
+  EXPECT_GT(r->where->z, 10);
+}
+
 TEST(Execution, AFilledSlotIsExcessMaterial) {
   Case c(1.0);
   const Solid block = c.box({{5, 5, 0}, {25, 25, 6}});
