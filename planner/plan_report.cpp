@@ -123,11 +123,33 @@ json rejected_json(const PlanningResult& r) {
 std::string rejected_summary(const PlanningResult& r) {
   std::ostringstream os;
   os << "validated   every plan offered was exported and executed from the raw stock; " << r.rejected.size()
-     << " candidate" << (r.rejected.size() == 1 ? "" : "s") << " rejected\n";
-  // One line each: the expression, the cost and the first reason, short; a reason told in
-  // full once (candidates that begin the same way fail the same way).
-  std::vector<std::string> told;
+     << " candidate" << (r.rejected.size() == 1 ? "" : "s") << " rejected";
+  // How many failed first for which reason: what stands between the part and a plan.
+  std::vector<std::pair<std::string, int>> by_kind;
   for (const RejectedPlan& candidate : r.rejected) {
+    const std::string kind = candidate.reasons.empty() ? std::string("no reason") : candidate.reasons.front().kind;
+    auto it = std::find_if(by_kind.begin(), by_kind.end(), [&](const auto& k) { return k.first == kind; });
+    if (it == by_kind.end())
+      by_kind.emplace_back(kind, 1);
+    else
+      ++it->second;
+  }
+  std::stable_sort(by_kind.begin(), by_kind.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
+  for (std::size_t i = 0; i < by_kind.size(); ++i)
+    os << (i == 0 ? " (first reasons: " : ", ") << by_kind[i].first << " " << by_kind[i].second
+       << (i + 1 == by_kind.size() ? ")" : "");
+  os << "\n";
+  // One line each for the cheapest: the expression, the cost and the first reason, short; a
+  // reason told in full once (candidates that begin the same way fail the same way). The
+  // rest are counted; plan.json has them all.
+  constexpr std::size_t kShown = 20;
+  std::vector<std::string> told;
+  for (std::size_t n = 0; n < r.rejected.size(); ++n) {
+    const RejectedPlan& candidate = r.rejected[n];
+    if (n == kShown) {
+      os << "  ... and " << r.rejected.size() - kShown << " more candidates in plan.json\n";
+      break;
+    }
     os << "  x " << expression(r.problem, candidate.plan) << "  cost " << fixed(candidate.plan.cost, 4);
     if (candidate.reasons.empty()) {
       os << "\n";

@@ -105,7 +105,8 @@ TEST(PlanInMemory, RejectedCandidatesAreKeptWithTheirReasonsAndReadBack) {
   EXPECT_EQ(disk.rejected[0].reasons, result.rejected[0].reasons);
   EXPECT_EQ(disk.rejected[1].reasons, result.rejected[1].reasons);
   EXPECT_EQ(disk.rejected[0].actions.size(), result.rejected[0].plan.steps.size());
-  EXPECT_NE(plan_summary(result, sources).find("2 candidates rejected"), std::string::npos);
+  const std::string summary = plan_summary(result, sources);
+  EXPECT_NE(summary.find("2 candidates rejected (first reasons: gouge 1, missing_material 1)"), std::string::npos) << summary;
 }
 
 }  // namespace
