@@ -63,11 +63,28 @@ struct ProgramExecutor::Impl {
     for (const auto& t : m.tools) cutters.emplace(t.number, cutter_of(t));
     for (std::size_t i = 0; i < m.heads.size(); ++i) beads.emplace(instruments::head_tool_number(m, i), bead_of(m.heads[i]));
     if (options.stock) {
-      part_stock = *options.stock;
+      // Moved out: a snapshot need not carry the start as well.
+      part_stock = std::move(*options.stock);
+      options.stock.reset();
       domain = part_stock->storage_box();
     }
     current = setup_of(54);
   }
+  // A deep copy (the simulation too); the machine, and the setups `frame` and `current`
+  // point into, are shared.
+  Impl(const Impl& o)
+      : machine(o.machine),
+        file_name(o.file_name),
+        options(o.options),
+        interp(o.interp),
+        cutters(o.cutters),
+        beads(o.beads),
+        part_stock(o.part_stock),
+        domain(o.domain),
+        frame(o.frame),
+        sim(o.sim ? std::make_unique<MaterialSimulation>(*o.sim) : nullptr),
+        finished(o.finished),
+        current(o.current) {}
 
   const config::Setup* setup_of(int offset) const {
     for (const auto& s : machine.setups)
@@ -97,7 +114,37 @@ struct ProgramExecutor::Impl {
 ProgramExecutor::ProgramExecutor(const config::Machine& machine, std::string file_name, ExecutorOptions options,
                                  gcode::InterpreterOptions interpreter)
     : impl_(std::make_unique<Impl>(machine, std::move(file_name), std::move(options), interpreter)) {}
+ProgramExecutor::ProgramExecutor(const Snapshot& snapshot) : impl_(std::make_unique<Impl>(*snapshot.impl_)) {}
 ProgramExecutor::~ProgramExecutor() = default;
+
+ProgramExecutor::Snapshot::Snapshot() = default;
+ProgramExecutor::Snapshot::~Snapshot() = default;
+ProgramExecutor::Snapshot::Snapshot(Snapshot&&) noexcept = default;
+ProgramExecutor::Snapshot& ProgramExecutor::Snapshot::operator=(Snapshot&&) noexcept = default;
+
+ProgramExecutor::Snapshot ProgramExecutor::snapshot() const {
+  Snapshot s;
+  s.impl_ = std::make_unique<Impl>(*impl_);
+  return s;
+}
+
+std::size_t ProgramExecutor::Snapshot::bytes() const {
+  if (!impl_) return 0;
+  const auto solid = [](const Solid& s) {
+    const IndexBox b = s.storage_box();
+    return sizeof(Solid) + (b.empty() ? 0 : std::size_t(s.words_per_row()) * std::size_t(b.hi.y - b.lo.y) *
+                                                std::size_t(b.hi.z - b.lo.z) * sizeof(std::uint64_t));
+  };
+  const Impl& i = *impl_;
+  std::size_t n = sizeof(Impl) + i.finished.incidents.size() * sizeof(Incident);
+  if (i.part_stock) n += solid(*i.part_stock);
+  if (i.options.protected_region) n += solid(*i.options.protected_region);
+  if (i.sim) {
+    n += sizeof(MaterialSimulation) + solid(i.sim->stock()) + i.sim->report().incidents.size() * sizeof(Incident);
+    if (i.sim->protected_region()) n += solid(*i.sim->protected_region());
+  }
+  return n;
+}
 ProgramExecutor::ProgramExecutor(ProgramExecutor&&) noexcept = default;
 ProgramExecutor& ProgramExecutor::operator=(ProgramExecutor&&) noexcept = default;
 

@@ -54,6 +54,8 @@ struct LineOutcome {
 };
 
 class ProgramExecutor {
+  struct Impl;
+
  public:
   ProgramExecutor(const config::Machine& machine, std::string file_name, ExecutorOptions options = {},
                   gcode::InterpreterOptions interpreter = {});
@@ -77,8 +79,27 @@ class ProgramExecutor {
   // Totals over everything executed so far.
   SimulationReport report() const;
 
+  // Everything the executor holds after the lines so far (interpreter, stock, active
+  // frame, protected region, report), to go on from later (validation/ resumes plans from
+  // a prefix it executed before). Its machine is kept by reference, as the executor's.
+  class Snapshot {
+   public:
+    Snapshot();
+    ~Snapshot();
+    Snapshot(Snapshot&&) noexcept;
+    Snapshot& operator=(Snapshot&&) noexcept;
+    // Estimated memory, bytes: mostly the voxel solids.
+    std::size_t bytes() const;
+
+   private:
+    friend class ProgramExecutor;
+    std::unique_ptr<Impl> impl_;
+  };
+  Snapshot snapshot() const;
+  // An executor that goes on from `snapshot` exactly as the one it was taken from would.
+  explicit ProgramExecutor(const Snapshot& snapshot);
+
  private:
-  struct Impl;
   std::unique_ptr<Impl> impl_;
 };
 

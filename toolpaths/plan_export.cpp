@@ -1,5 +1,7 @@
 #include "toolpaths/plan_export.hpp"
 
+#include <stdexcept>
+
 #include "common/error.hpp"
 #include "instruments/bead.hpp"
 
@@ -68,16 +70,21 @@ std::vector<std::string> path_defects(const PlanExport& exported) {
   return out;
 }
 
-PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
-                       const ExportOptions& options, const MaterialAfter& material_after) {
+namespace {
+
+void check_machine(const planner::PlanFile& file, const config::Machine& machine) {
   if (file.machine_name != machine.name)
     throw InputError("the plan was made for machine '" + file.machine_name + "', not '" + machine.name +
                      "'; expected the machine file it was planned with (" + file.machine_file + ")");
-  PlanExport out;
-  const std::vector<geometry::Solid> planned = planner::plan_states(file, plan);
-  geometry::Solid present = planned.front();
+}
+
+// Actions `first`.. of the plan into `out`; `present` is the material the first one meets
+// when the material present is fed back, `planned` the planned states otherwise.
+void export_from(int first, geometry::Solid present, const std::vector<geometry::Solid>& planned,
+                 const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+                 const ExportOptions& options, const MaterialAfter& material_after, PlanExport& out) {
   const int n = int(plan.actions.size());
-  for (int k = 0; k < n; ++k) {
+  for (int k = first; k < n; ++k) {
     if (options.progress) options.progress(k + 1, n);
     const planner::PlanFilePrimitive& p = file.primitives[std::size_t(plan.actions[std::size_t(k)].primitive)];
     const bool additive = p.mode == planner::Mode::Additive;
@@ -102,6 +109,34 @@ PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePla
     if (material_after) present = material_after(a);
     out.actions.push_back(std::move(a));
   }
+}
+
+}  // namespace
+
+PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+                       const ExportOptions& options, const MaterialAfter& material_after) {
+  check_machine(file, machine);
+  PlanExport out;
+  const std::vector<geometry::Solid> planned = planner::plan_states(file, plan);
+  export_from(0, planned.front(), planned, file, plan, machine, options, material_after, out);
+  return out;
+}
+
+PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+                       const ExportOptions& options, const MaterialAfter& material_after, ExportStart start) {
+  if (!material_after) throw std::invalid_argument("export_plan: a start needs material_after");
+  if (start.actions.size() > plan.actions.size())
+    throw std::invalid_argument("export_plan: a start with more actions than the plan");
+  check_machine(file, machine);
+  PlanExport out;
+  // The raw stock's label, as the actions of the start set it.
+  for (std::size_t k = 0; k < start.actions.size(); ++k) {
+    const planner::PlanFilePrimitive& p = file.primitives.at(std::size_t(plan.actions[k].primitive));
+    if (p.raw_stock()) out.raw_stock = p.label;
+  }
+  const int first = int(start.actions.size());
+  out.actions = std::move(start.actions);
+  export_from(first, std::move(start.present), {}, file, plan, machine, options, material_after, out);
   return out;
 }
 

@@ -64,6 +64,21 @@ struct PlanExport {
 PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
                        const ExportOptions& options = {}, const MaterialAfter& material_after = {});
 
+// Where export starts when the first actions of the plan were made before, with the same
+// file, machine and options (validation/ resumes candidates from a prefix it executed):
+// those actions as they were made (their solids may be left out), and the material
+// present after them, as `material_after` returned it. Export goes on from the next action
+// as it would have had it made them itself.
+struct ExportStart {
+  std::vector<ExportedAction> actions;
+  geometry::Solid present;
+};
+
+// export_plan from `start`; `material_after` is required (std::invalid_argument otherwise).
+// The actions of `start` come first in the result; progress is called for the others.
+PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+                       const ExportOptions& options, const MaterialAfter& material_after, ExportStart start);
+
 // The path defects of the actions, each as "action K (P..): message".
 // Export refuses a plan that has any (docs/export.md): the part would be wrong.
 std::vector<std::string> path_defects(const PlanExport& exported);

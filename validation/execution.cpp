@@ -1,11 +1,15 @@
 #include "validation/execution.hpp"
 
+#include <list>
+#include <map>
 #include <optional>
+#include <utility>
 
 #include "common/error.hpp"
 #include "gcode/post.hpp"
 #include "planner/start_stock.hpp"
 #include "sim/executor.hpp"
+#include "validation/prefix_cache.hpp"
 
 namespace hybridctl::validation {
 namespace {
@@ -22,6 +26,109 @@ Solid on_domain(const Solid& s, const planner::PlanFile& file) {
   return out;
 }
 
+// What a run holds after a prefix of a plan that went right: all it needs to go on with
+// the next action (the programs made so far are those of `actions` that make G-code).
+struct PrefixState {
+  sim::ProgramExecutor::Snapshot executor;
+  std::vector<toolpaths::ExportedAction> actions;  // light: without their solids
+  gcode::PostedProgram prefix;
+  std::size_t fed = 0;
+  int protecting = 0;
+  std::vector<std::string> errors;
+  std::size_t bytes = 0;
+};
+
+std::size_t program_bytes(const gcode::ActionProgram& p) {
+  std::size_t n = sizeof(p) + p.path.moves.size() * sizeof(gcode::PathMove);
+  for (const gcode::PathMove& m : p.path.moves) n += m.comment.capacity();
+  for (const std::string& w : p.path.warnings) n += sizeof(w) + w.capacity();
+  return n + p.path.defects.size() * sizeof(gcode::PathDefect);
+}
+
+std::size_t state_bytes(const PrefixState& s) {
+  std::size_t n = sizeof(s) + s.executor.bytes();
+  for (const toolpaths::ExportedAction& a : s.actions) n += sizeof(a) + program_bytes(a.program);
+  for (const std::string& l : s.prefix.lines) n += sizeof(l) + l.capacity();
+  n += s.prefix.origins.size() * sizeof(gcode::LineOrigin) + s.prefix.actions.size() * sizeof(gcode::ProgramAction);
+  return n;
+}
+
+}  // namespace
+
+namespace detail {
+
+// Prefixes by the primitives of their actions, least recently used first.
+struct PrefixCacheImpl {
+  using Entry = std::pair<std::vector<int>, PrefixState>;
+  std::size_t max_bytes = 0;
+  PrefixCacheStats stats;
+  std::list<Entry> lru;  // front: most recently used
+  std::map<std::vector<int>, std::list<Entry>::iterator> index;
+  const planner::PlanFile* file = nullptr;
+  const config::Machine* machine = nullptr;
+
+  void clear() {
+    lru.clear();
+    index.clear();
+    stats.entries = 0;
+    stats.bytes = 0;
+  }
+  // Empties the cache when it is asked about another file or machine than the last.
+  void serve(const planner::PlanFile& f, const config::Machine& m) {
+    if (file == &f && machine == &m) return;
+    clear();
+    file = &f;
+    machine = &m;
+  }
+  // The longest prefix of `actions` held, marked used.
+  const PrefixState* longest(const std::vector<int>& actions) {
+    ++stats.lookups;
+    for (std::size_t k = actions.size(); k > 0; --k) {
+      const auto it = index.find(std::vector<int>(actions.begin(), actions.begin() + std::ptrdiff_t(k)));
+      if (it == index.end()) continue;
+      lru.splice(lru.begin(), lru, it->second);
+      ++stats.hits;
+      stats.resumed_actions += k;
+      return &it->second->second;
+    }
+    return nullptr;
+  }
+  void store(std::vector<int> key, PrefixState state) {
+    state.bytes = state_bytes(state);
+    if (state.bytes > max_bytes) return;
+    if (const auto it = index.find(key); it != index.end()) {
+      stats.bytes -= it->second->second.bytes;
+      lru.erase(it->second);
+      index.erase(it);
+      --stats.entries;
+    }
+    while (!lru.empty() && stats.bytes + state.bytes > max_bytes) {
+      stats.bytes -= lru.back().second.bytes;
+      index.erase(lru.back().first);
+      lru.pop_back();
+      --stats.entries;
+      ++stats.evicted;
+    }
+    stats.bytes += state.bytes;
+    ++stats.entries;
+    ++stats.stored;
+    lru.emplace_front(key, std::move(state));
+    index.emplace(std::move(key), lru.begin());
+  }
+};
+
+}  // namespace detail
+
+PrefixCache::PrefixCache(std::size_t max_bytes) : impl_(std::make_unique<detail::PrefixCacheImpl>()) {
+  impl_->max_bytes = max_bytes;
+}
+PrefixCache::~PrefixCache() = default;
+const PrefixCacheStats& PrefixCache::stats() const { return impl_->stats; }
+std::size_t PrefixCache::max_bytes() const { return impl_->max_bytes; }
+void PrefixCache::clear() { impl_->clear(); }
+
+namespace {
+
 // The whole plan's program fed to the simulated machine action by action. After each
 // action the program of the actions made so far is posted and its lines up to the end of
 // the newest action's block are executed: the post-processor writes an action's block from
@@ -36,6 +143,29 @@ class IncrementalRun {
         plan_(plan),
         options_(options),
         executor_(machine, "plan", executor_options(file, start, options)) {}
+
+  // Going on after a prefix of `plan` run before (same file, machine and options).
+  IncrementalRun(const config::Machine& machine, const planner::PlanFile& file, const planner::PlanFilePlan& plan,
+                 const PrefixState& from, const ExecutionOptions& options)
+      : machine_(machine),
+        file_(file),
+        plan_(plan),
+        options_(options),
+        executor_(from.executor),
+        actions_(from.actions),
+        prefix_(from.prefix),
+        fed_(from.fed),
+        protecting_(from.protecting),
+        errors_(from.errors) {
+    for (const toolpaths::ExportedAction& a : actions_)
+      if (a.makes_gcode) made_.push_back(a.program);
+  }
+
+  // Keeps the state after every action that went right, as all before it did, in `cache`.
+  void keep_in(detail::PrefixCacheImpl* cache) { cache_ = cache; }
+
+  // The material present now, as after() returns it.
+  Solid present() const { return on_domain(executor_.stock(), file_); }
 
   // Programs made without feedback: executed at finish().
   void take(std::vector<gcode::ActionProgram> programs) { made_ = std::move(programs); }
@@ -55,9 +185,11 @@ class IncrementalRun {
       prefix_ = gcode::post_program(made_, machine_, options_.export_options.post);
       feed(prefix_, prefix_.actions.back().last_line);
     }
-    if (options_.run_until == RunUntil::FirstFailingAction &&
-        (!made.program.path.defects.empty() || !errors_.empty() || !executor_.report().incidents.empty()))
-      throw Stopped{made.step};
+    const bool wrong = !made.program.path.defects.empty() || !errors_.empty() || !executor_.report().incidents.empty();
+    if (options_.run_until == RunUntil::FirstFailingAction && wrong) throw Stopped{made.step};
+    // Only a prefix that went right is kept: it is the same whatever RunUntil says.
+    right_ = right_ && !wrong;
+    if (cache_ && right_) keep(made.step);
     return on_domain(executor_.stock(), file_);
   }
 
@@ -96,6 +228,18 @@ class IncrementalRun {
     o.simulation = options.simulation;
     return o;
   }
+  void keep(int actions) {
+    std::vector<int> key;
+    for (int k = 0; k < actions; ++k) key.push_back(plan_.actions[std::size_t(k)].primitive);
+    PrefixState state;
+    state.executor = executor_.snapshot();
+    state.actions = actions_;
+    state.prefix = prefix_;
+    state.fed = fed_;
+    state.protecting = protecting_;
+    state.errors = errors_;
+    cache_->store(std::move(key), std::move(state));
+  }
   void feed(const gcode::PostedProgram& program, std::size_t up_to) {
     for (; fed_ < up_to && fed_ < program.lines.size(); ++fed_) {
       protect_for(program.action_at(std::uint32_t(fed_ + 1)));
@@ -125,18 +269,19 @@ class IncrementalRun {
   std::size_t fed_ = 0;
   int protecting_ = 0;  // the action whose spared region the executor holds (0: none yet)
   std::vector<std::string> errors_;
+  detail::PrefixCacheImpl* cache_ = nullptr;
+  bool right_ = true;  // every action so far went right (a resumed run starts from such a prefix)
 };
 
-}  // namespace
-
-Execution execute_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
-                       const ExecutionOptions& options) {
+// Exports and executes `plan` with `run`, from `start` when it resumes a prefix.
+Execution run_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+                   const ExecutionOptions& options, IncrementalRun& run, std::optional<toolpaths::ExportStart> start) {
   Execution out;
-  IncrementalRun run(machine, file, plan, planner::start_stock(file, plan, machine), options);
   if (options.planned_against == PlannedAgainst::MaterialPresent) {
     try {
-      out.exported = toolpaths::export_plan(file, plan, machine, options.export_options,
-                                            [&run](const toolpaths::ExportedAction& made) { return run.after(made); });
+      const toolpaths::MaterialAfter after = [&run](const toolpaths::ExportedAction& made) { return run.after(made); };
+      out.exported = start ? toolpaths::export_plan(file, plan, machine, options.export_options, after, std::move(*start))
+                           : toolpaths::export_plan(file, plan, machine, options.export_options, after);
     } catch (const IncrementalRun::Stopped& stop) {
       run.stopped(out);
       out.stopped_after = stop.action;
@@ -151,6 +296,34 @@ Execution execute_plan(const planner::PlanFile& file, const planner::PlanFilePla
   out.deviation = planner::measure_deviation(out.as_built, file.design, file.domain, file.tolerance);
   out.reasons = rejection_reasons(out, file, machine);
   return out;
+}
+
+}  // namespace
+
+Execution execute_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+                       const ExecutionOptions& options) {
+  IncrementalRun run(machine, file, plan, planner::start_stock(file, plan, machine), options);
+  return run_plan(file, plan, machine, options, run, std::nullopt);
+}
+
+Execution execute_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+                       const ExecutionOptions& options, PrefixCache* cache) {
+  // The planned state does not depend on what the simulation holds: nothing to resume.
+  if (!cache || options.planned_against != PlannedAgainst::MaterialPresent)
+    return execute_plan(file, plan, machine, options);
+  detail::PrefixCacheImpl& c = cache->impl();
+  c.serve(file, machine);
+  std::vector<int> key;
+  for (const planner::PlanFileAction& a : plan.actions) key.push_back(a.primitive);
+  if (const PrefixState* from = c.longest(key)) {
+    IncrementalRun run(machine, file, plan, *from, options);
+    run.keep_in(&c);
+    toolpaths::ExportStart start{from->actions, run.present()};
+    return run_plan(file, plan, machine, options, run, std::move(start));
+  }
+  IncrementalRun run(machine, file, plan, planner::start_stock(file, plan, machine), options);
+  run.keep_in(&c);
+  return run_plan(file, plan, machine, options, run, std::nullopt);
 }
 
 }  // namespace hybridctl::validation

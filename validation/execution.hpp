@@ -25,6 +25,7 @@
 #include "planner/rejection.hpp"
 #include "sim/material.hpp"
 #include "toolpaths/plan_export.hpp"
+#include "validation/prefix_cache.hpp"
 
 namespace hybridctl::validation {
 
@@ -58,7 +59,8 @@ struct ExecutionOptions {
 
 struct Execution {
   toolpaths::PlanExport exported;      // toolpaths planned against the material present (when stopped early:
-                                       // the actions made, without their solids)
+                                       // the actions made, without their solids; resumed from a
+                                       // PrefixCache: the prefix's actions without their solids)
   gcode::PostedProgram program;        // the whole plan's program, as export writes it
   geometry::Solid as_built;            // part frame, the plan's lattice and domain
   sim::SimulationReport report;        // incidents carry the program's lines
@@ -79,6 +81,14 @@ struct Execution {
 // gcode::post_program do.
 Execution execute_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
                        const ExecutionOptions& options = {});
+
+// execute_plan resumed from the longest prefix of `plan` that `cache` holds, keeping the
+// state after each action that goes right in it (validation/prefix_cache.hpp): the same
+// Execution as from the raw stock (reasons, lines, program, as built, report), but for the
+// solids of the resumed actions in `exported`. `cache` serves one file, machine and
+// options; null, or PlannedAgainst::PlannedState, executes from the raw stock.
+Execution execute_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+                       const ExecutionOptions& options, PrefixCache* cache);
 
 // The reasons of an execution, as execute_plan fills `reasons`: the toolpaths' defects
 // (layer skipped, region unreachable), every incident kind per action (rapid into

@@ -16,18 +16,21 @@ planner::PlanFilePlan candidate_plan(const planner::PlanningResult& r, const pla
   return out;
 }
 
-PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions options) {
+PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions options, std::shared_ptr<PrefixCache> cache) {
   struct State {
     ExecutionOptions options;
     std::optional<planner::PlanFile> file;  // the planning result's grid, design and primitives
     // Execution is deterministic and an action depends only on the ones before it: a
     // candidate that begins with the actions a rejected one failed in fails the same way.
     std::vector<std::pair<std::vector<int>, std::vector<planner::RejectionReason>>> failed_prefixes;
+    // ... and the same holds for the prefixes that went right: candidates go on from there.
+    std::shared_ptr<PrefixCache> cache;
   };
   // A candidate is rejected at its first failing action: its first reasons are enough.
   options.run_until = RunUntil::FirstFailingAction;
   auto state = std::make_shared<State>();
   state->options = std::move(options);
+  state->cache = cache ? std::move(cache) : std::make_shared<PrefixCache>();
   return [&machine, state](const planner::PlanningResult& r, const planner::Plan& plan) {
     if (!state->file) {
       // No plans yet: only the grid, the design and the primitives are taken.
@@ -41,7 +44,7 @@ PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions option
                      [](int p, const planner::PlanFileAction& a) { return p == a.primitive; }))
         return reasons;
     try {
-      Execution run = execute_plan(*state->file, candidate, machine, state->options);
+      Execution run = execute_plan(*state->file, candidate, machine, state->options, state->cache.get());
       if (run.stopped_after > 0) {
         std::vector<int> prefix;
         for (int k = 0; k < run.stopped_after; ++k) prefix.push_back(candidate.actions[std::size_t(k)].primitive);

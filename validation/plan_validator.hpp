@@ -9,6 +9,7 @@
 //   // r.plans: proven; r.rejected: the candidates that failed, with their reasons
 
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "config/machine.hpp"
@@ -21,7 +22,10 @@ using PlanCheck = std::function<std::vector<planner::RejectionReason>(const plan
 
 // The hook. It keeps `machine` by reference (it must outlive planning) and turns the
 // planning result into a plan file (planner::to_plan_file) once, at the first candidate.
-PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions options = {});
+// Candidates resume from the prefixes `cache` holds (one is made when none is given; pass
+// one to read its stats); it must serve this validator alone.
+PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions options = {},
+                         std::shared_ptr<PrefixCache> cache = nullptr);
 
 // One candidate of a planning result as the plan file names it (rank 0).
 planner::PlanFilePlan candidate_plan(const planner::PlanningResult& result, const planner::Plan& plan);

@@ -10,8 +10,7 @@
 #include <algorithm>
 
 #include "../planner/planner_fixtures.hpp"
-#include "config/machine_loader.hpp"
-#include "geometry/shapes.hpp"
+#include "validation_cases.hpp"
 #include "validation/plan_validator.hpp"
 
 namespace hybridctl::validation {
@@ -19,51 +18,8 @@ namespace {
 
 using geometry::Box3;
 using geometry::Solid;
-
-const config::Machine& machine() {
-  static const config::Machine m = config::load_machine("examples/machines/hybrid-3axis.yaml");
-  return m;
-}
-
-// A plan file built by hand: 0.5 mm voxels over 40 x 30 x 24 mm from the origin.
-struct Case {
-  planner::PlanFile file;
-
-  explicit Case(double tolerance) {
-    file.machine_name = machine().name;
-    file.lattice = {0.5, {0, 0, 0}};
-    file.domain = {{0, 0, 0}, {80, 60, 48}};
-    file.tolerance = tolerance;
-    file.design = Solid(file.lattice, file.domain);
-  }
-  Solid box(Box3 b) const { return geometry::make_box(file.lattice, b); }
-  int add(const std::string& kind, planner::Mode mode, const std::string& capability, const std::string& setup,
-          const Solid& region, int tool_number = 0) {
-    planner::PlanFilePrimitive p;
-    p.name = "P" + std::to_string(file.primitives.size() + 1);
-    p.label = kind + " " + capability;
-    p.kind = kind;
-    p.mode = mode;
-    p.capability = capability;
-    p.setup = setup;
-    p.tool_number = tool_number;
-    p.region = intersect(region, Solid::filled(file.lattice, file.domain));
-    file.primitives.push_back(std::move(p));
-    return int(file.primitives.size()) - 1;
-  }
-  int stock(const Solid& region) { return add("raw-stock", planner::Mode::Additive, "block", "", region); }
-  int deposit(const Solid& region, const std::string& setup = "top") {
-    return add("u-am", planner::Mode::Additive, "ded", setup, region);
-  }
-  int mill(const Solid& region, int tool, const std::string& setup = "top") {
-    return add("sm-cons", planner::Mode::Subtractive, "T" + std::to_string(tool), setup, region, tool);
-  }
-  planner::PlanFilePlan plan(std::vector<int> actions) const {
-    planner::PlanFilePlan p;
-    for (int a : actions) p.actions.push_back({a, 0, 0});
-    return p;
-  }
-};
+using cases::Case;
+using cases::machine;
 
 std::vector<std::string> kinds(const Execution& run) {
   std::vector<std::string> out;
