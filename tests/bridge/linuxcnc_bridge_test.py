@@ -222,6 +222,19 @@ def pick_plan(plan_dir):
                   json.dumps([kinds(p) for p in plans])[:2000])
 
 
+def pick_deposit_plan(plan_dir):
+    """The first plan that only deposits (the flanged hub from -Z, unvalidated): a program
+    that switches the deposition output on and off thousands of times."""
+    doc = json.load(open(os.path.join(plan_dir, "plan.json")))
+    names = {p["name"]: p.get("label", "") for p in doc["primitives"]}
+    for i, plan in enumerate(doc["plans"]):
+        labels = [names.get(a["primitive"], "") for a in plan["actions"]]
+        if labels and all(a["mode"] == "additive" for a in plan["actions"]) and \
+                all(re.match(r"[UO]-AM ", n) for n in labels):
+            return i + 1
+    raise Failure("no plan in " + plan_dir + " only deposits")
+
+
 def program_lines(job_dir):
     """The program the host streamed (its job directory keeps it)."""
     for name in sorted(os.listdir(job_dir)):
@@ -449,7 +462,7 @@ def main():
     args.plan_dir = os.path.abspath(args.plan_dir)
     args.work = os.path.abspath(args.work)
     ini = prepare_work(args.work)
-    plan = pick_plan(args.plan_dir)
+    plan = pick_deposit_plan(args.plan_dir) if args.case == "socketcand" else pick_plan(args.plan_dir)
     print("plan %d of %s" % (plan, args.plan_dir))
     try:
         globals()["run_" + args.case](args, ini, plan)
@@ -512,8 +525,14 @@ def run_socketcand(args, ini, plan):
         check_every_line_once(program, executed(line_log))
         print("figure segments %d" % len(check_segments(bridge.output(), len(program))))
         print("figure socketcand_seconds %.1f" % seconds)
+        samples = cnc.samples()
     finally:
         cnc.stop()
+    check(samples, "HAL's sampler recorded nothing")
+    toggles, misplaced = check_deposition(program, samples)
+    check(toggles > 0, "the depositing program never switched LinuxCNC's deposition output")
+    print("deposition toggled %d times (%d not within %.0f mm of the program's place)" %
+          (toggles, misplaced, TOGGLE_TOLERANCE_MM))
 
 
 def run_estop(args, ini, plan):
