@@ -3,12 +3,18 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <map>
+#include <memory>
 
 #include "common/error.hpp"
+#include "common/number_text.hpp"
 #include "geometry/vdb_file.hpp"
 #include "geometry/voxelize.hpp"
+#include "instruments/elements.hpp"
+#include "planner/deposit_reach.hpp"
 #include "planner/memory_estimate.hpp"
 
 namespace hybridctl::planner {
@@ -102,7 +108,44 @@ void decompose_into_atoms(const Progress& progress, PlanningResult& r) {
 
 // The symbolic problem the search runs on: atoms with volumes and classes, primitives as
 // sets of atoms.
-PlanningProblem symbolic_problem(const PlanningResult& r, const config::Planning& defaults, int max_uses) {
+// Per head and setup, which present atoms keep the head from an atom: over it in its
+// column, or in the nozzle's way (deposit_reach.hpp); setups that share an approach share
+// the relation.
+std::shared_ptr<const std::vector<AtomSet>> reach_limits(const PlanningResult& r, const config::Machine& machine,
+                                                         const Primitive& prim,
+                                                         std::map<std::pair<int, int>, std::shared_ptr<const std::vector<AtomSet>>>& cache) {
+  if (prim.kind != PrimitiveKind::UAm && prim.kind != PrimitiveKind::OAm) return nullptr;
+  const auto head = std::find_if(machine.heads.begin(), machine.heads.end(),
+                                 [&](const config::AdditiveHead& h) { return h.name == prim.capability; });
+  const auto setup = std::find_if(machine.setups.begin(), machine.setups.end(),
+                                  [&](const config::Setup& s) { return s.name == prim.setup; });
+  if (head == machine.heads.end() || setup == machine.setups.end()) return nullptr;
+  const geometry::AxisDirection approach = instruments::approach_direction(setup->approach);
+  const int gap = deposit_reach_gap(head->layer_height, r.lattice.voxel_size);
+  auto& slot = cache[{int(approach.axis) * 2 + (approach.sign > 0), gap * 1000 + int(head - machine.heads.begin())}];
+  if (slot) return slot;
+  std::vector<AtomSet> blocked = atoms_above(r.atoms, approach, gap);
+  if (head->nozzle) {
+    const double h = r.lattice.voxel_size;
+    const NozzleReach nozzle{head->nozzle->diameter / 2 / h, int(std::ceil(head->nozzle->standoff / h - 1e-9)),
+                             int(std::floor(head->nozzle->length / h + 1e-9))};
+    const std::vector<AtomSet> touched = atoms_in_nozzle_reach(r.atoms, approach, nozzle);
+    for (std::size_t a = 0; a < blocked.size(); ++a) {
+      if (touched[a].words().empty()) continue;
+      if (blocked[a].words().empty()) {
+        blocked[a] = touched[a];
+        continue;
+      }
+      for (std::size_t w = 0; w < blocked[a].words().size(); ++w) blocked[a].words()[w] |= touched[a].words()[w];
+    }
+  }
+  slot = std::make_shared<const std::vector<AtomSet>>(std::move(blocked));
+  return slot;
+}
+
+PlanningProblem symbolic_problem(const PlanningResult& r, const config::Machine& machine, int max_uses) {
+  const config::Planning& defaults = machine.planning;
+  std::map<std::pair<int, int>, std::shared_ptr<const std::vector<AtomSet>>> reach_cache;
   PlanningProblem p;
   p.normaliser = r.bounding_box_volume > 0 ? r.bounding_box_volume : 1.0;
   p.max_uses = max_uses;
@@ -123,6 +166,7 @@ PlanningProblem symbolic_problem(const PlanningResult& r, const config::Planning
     s.cost_per_mm3 = prim.cost_per_mm3;
     s.tool = prim.capability;
     s.setup = prim.setup;
+    s.blocked_by = reach_limits(r, machine, prim, reach_cache);
     s.atoms = AtomSet(r.atoms.atom_count());
     for (int a = 0; a < r.atoms.atom_count(); ++a)
       if (r.atoms.code(a).test(int(i))) s.atoms.set(a);
@@ -151,6 +195,45 @@ std::function<bool(const Plan&)> accept_hook(const PlanningOptions& options, Pla
   };
 }
 
+// Why no plan exists when every state the primitives reach keeps an atom wrong: the
+// nearest such state, and its largest wrong atoms with where they are and what holds them.
+std::string unreachable_text(const PlanningResult& r, const Reachability& reach) {
+  struct Wrong {
+    int atom;
+    double volume;
+  };
+  std::vector<Wrong> missing, extra;
+  double missing_volume = 0, extra_volume = 0;
+  for (std::size_t a = 0; a < r.problem.atoms.size(); ++a) {
+    const AtomSpec& spec = r.problem.atoms[a];
+    const bool present = reach.nearest.test(int(a));
+    if (spec.must_in && !present) missing.push_back({int(a), spec.volume}), missing_volume += spec.volume;
+    if (spec.must_out && present) extra.push_back({int(a), spec.volume}), extra_volume += spec.volume;
+  }
+  const auto largest = [&](std::vector<Wrong>& atoms) {
+    const auto big = std::max_element(atoms.begin(), atoms.end(), [](const Wrong& a, const Wrong& b) { return a.volume < b.volume; });
+    const AtomMeasures& m = r.measures[std::size_t(big->atom)];
+    char where[96];
+    std::snprintf(where, sizeof where, "%.3g mm\u00B3 around (%.1f, %.1f, %.1f) mm", m.volume, m.centroid.x, m.centroid.y,
+                  m.centroid.z);
+    std::string in;
+    for (std::size_t i = 0; i < r.problem.primitives.size(); ++i)
+      if (r.problem.primitives[i].atoms.test(big->atom)) in += (in.empty() ? "" : ", ") + r.problem.primitives[i].name;
+    return std::string(where) + (in.empty() ? ", in no primitive" : ", in " + in);
+  };
+  char head[160];
+  std::snprintf(head, sizeof head, "no sequence of these primitives makes the design: none of the %lld states they reach "
+                "(costs aside, each primitive any number of times) is within tolerance",
+                static_cast<long long>(reach.states));
+  std::string s = head;
+  s += ". The nearest lacks " + trimmed_number(missing_volume, 1) + " mm\u00B3 of design in " + std::to_string(missing.size()) +
+       " atoms";
+  if (!missing.empty()) s += " (largest: " + largest(missing) + ")";
+  s += " and holds " + trimmed_number(extra_volume, 1) + " mm\u00B3 outside it in " + std::to_string(extra.size()) + " atoms";
+  if (!extra.empty()) s += " (largest: " + largest(extra) + ")";
+  return s + ". Deposits cannot reach under material already there, and removals cannot spare design they pass through";
+}
+
 void search_plans(int top_k, const PlanningOptions& options, const Progress& progress, PlanningResult& r,
                   double& validation_seconds) {
   progress("search", 0);
@@ -163,6 +246,19 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
   search.max_rejected = options.max_rejected;
   r.validated = bool(options.validate);
   r.plans = find_plans(r.problem, search, &r.search);
+  if (r.plans.empty() && r.search.limit_reached && !r.verdict.decided_without_search) {
+    // The search stopped without a plan: maybe none exists. Exploring what the primitives
+    // reach at all, costs aside, can prove it.
+    const Reachability reach = explore_reachable(r.problem);
+    if (reach.complete && !reach.goal) {
+      r.search.limit_reached = false;
+      r.search.exhausted = true;
+      r.verdict.manufacturable = false;
+      r.verdict.summary = unreachable_text(r, reach);
+      progress("search", 1);
+      return;
+    }
+  }
   progress("search", 1);
   if (r.plans.empty() && !r.verdict.decided_without_search) {
     r.verdict.manufacturable = false;
@@ -200,7 +296,7 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
   clock.lap("primitives");
   decompose_into_atoms(progress, r);
   clock.lap("atoms");
-  r.problem = symbolic_problem(r, defaults, options.max_uses);
+  r.problem = symbolic_problem(r, machine, options.max_uses);
   r.verdict = check_manufacturability(r.problem, r.measures, r.lattice);
   clock.lap("check");
   double validation_seconds = 0;

@@ -13,6 +13,7 @@
 #include <limits>
 #include <queue>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace hybridctl::planner {
 namespace {
@@ -26,7 +27,20 @@ double volume_of_bits(const PlanningProblem& p, const std::vector<std::uint64_t>
   return v;
 }
 
-// The state after applying primitive `i`, and the volume it really changes.
+// Whether material in `state` lies over an atom of `deposited` out of the head's reach.
+bool blocked(const std::vector<AtomSet>& blocked_by, const AtomSet& state, const std::vector<std::uint64_t>& deposited) {
+  const auto& s = state.words();
+  for (std::size_t w = 0; w < deposited.size(); ++w)
+    for (std::uint64_t b = deposited[w]; b; b &= b - 1) {
+      const auto& over = blocked_by[w * 64 + std::size_t(std::countr_zero(b))].words();
+      for (std::size_t k = 0; k < over.size(); ++k)
+        if (over[k] & s[k]) return true;
+    }
+  return false;
+}
+
+// The state after applying primitive `i`, and the volume it really changes; false when
+// it changes nothing or cannot be taken in this state.
 bool apply(const PlanningProblem& p, const AtomSet& state, int i, AtomSet& next, double& volume) {
   const PrimitiveSpec& prim = p.primitives[std::size_t(i)];
   const auto& s = state.words();
@@ -46,6 +60,7 @@ bool apply(const PlanningProblem& p, const AtomSet& state, int i, AtomSet& next,
     any = any || changed[w];
   }
   if (!any) return false;
+  if (prim.mode == Mode::Additive && prim.blocked_by && blocked(*prim.blocked_by, state, changed)) return false;
   volume = volume_of_bits(p, changed);
   return true;
 }
@@ -358,6 +373,51 @@ std::vector<Plan> find_plans(const PlanningProblem& p, const SearchOptions& opti
     plan.gap = st.lower_bound > 0 ? std::max(0.0, plan.cost / st.lower_bound - 1) : (plan.cost > 0 ? kInfinity : 0.0);
   st.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return plans;
+}
+
+Reachability explore_reachable(const PlanningProblem& p, std::int64_t max_states) {
+  Reachability r;
+  const int n = int(p.primitives.size());
+  const auto wrong = [&](const AtomSet& state) {
+    double v = 0;
+    for (std::size_t a = 0; a < p.atoms.size(); ++a) {
+      const bool present = state.test(int(a));
+      if ((p.atoms[a].must_in && !present) || (p.atoms[a].must_out && present)) v += p.atoms[a].volume;
+    }
+    return v;
+  };
+  std::unordered_set<AtomSet, AtomSetHash> seen;
+  std::deque<AtomSet> queue;
+  const AtomSet empty(int(p.atoms.size()));
+  r.nearest = empty;
+  r.wrong_volume = wrong(empty);
+  const std::vector<std::uint8_t> no_uses(std::size_t(n), 0);
+  // The empty state first, where raw stock may start the plan (C3, C4); later states
+  // never take raw stock, so an empty state reached again is another state than the start.
+  for (bool first = true; first || !queue.empty(); first = false) {
+    AtomSet state = first ? empty : std::move(queue.front());
+    if (!first) queue.pop_front();
+    for (int i = 0; i < n; ++i) {
+      if (!allowed(p, i, first, no_uses)) continue;
+      AtomSet next;
+      double volume = 0;
+      if (!apply(p, state, i, next, volume) || seen.count(next)) continue;
+      if (std::int64_t(seen.size()) >= max_states) return r;
+      ++r.states;
+      const double w = wrong(next);
+      if (w < r.wrong_volume) r.wrong_volume = w, r.nearest = next;
+      if (is_goal(p, next)) {
+        r.goal = true;
+        r.nearest = next;
+        r.wrong_volume = w;
+        return r;
+      }
+      seen.insert(next);
+      queue.push_back(std::move(next));
+    }
+  }
+  r.complete = true;
+  return r;
 }
 
 std::vector<Plan> enumerate_plans(const PlanningProblem& p, std::size_t limit) {

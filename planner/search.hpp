@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,10 @@ struct PrimitiveSpec {
   AtomSet atoms;          // the atoms inside the primitive
   std::string tool;       // tool or head identity, for tool-change costs
   std::string setup;      // setup name, for setup-change costs
+  // Additive only: for each atom, the atoms that, present, put part of it out of the head's
+  // reach (planner/deposit_reach.hpp). The action cannot be taken in a state that holds one
+  // of them over an atom it would deposit. Null: nothing limits it.
+  std::shared_ptr<const std::vector<AtomSet>> blocked_by;
 };
 
 struct FixedCosts {
@@ -124,6 +129,20 @@ std::vector<Plan> find_plans(const PlanningProblem& problem, const SearchOptions
 // Every plan, by depth-first enumeration, cheapest first, at most `limit` kept. The
 // oracle for find_plans on small problems.
 std::vector<Plan> enumerate_plans(const PlanningProblem& problem, std::size_t limit = SIZE_MAX);
+
+// Which states the primitives can reach at all, costs aside and each primitive any number
+// of times (a relaxation of max_uses): when none of them is a goal, no plan exists. Breadth
+// first from the empty state, at most `max_states` states.
+struct Reachability {
+  bool complete = false;  // every reachable state was visited
+  bool goal = false;      // a goal state is reachable (the exploration stops there)
+  std::int64_t states = 0;
+  // A reachable state with the least volume wrong (must-in atoms missing plus must-out
+  // atoms present), and that volume in mm^3.
+  AtomSet nearest;
+  double wrong_volume = 0;
+};
+Reachability explore_reachable(const PlanningProblem& problem, std::int64_t max_states = 200'000);
 
 // True when every must-in atom is in `state` and no must-out atom is.
 bool is_goal(const PlanningProblem& problem, const AtomSet& state);

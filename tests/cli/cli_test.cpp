@@ -39,6 +39,7 @@ class Cli : public hybridctl::cli_testing::DirectoryTest {
 };
 
 const std::string kBracket = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/bracket.stl";
+const std::string kFlangedHub = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/flanged-hub.stl";
 
 TEST_F(Cli, EverySubcommandHasHelp) {
   for (auto args : std::vector<std::vector<std::string>>{
@@ -145,8 +146,8 @@ namespace {
 
 const std::string kMachine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/hybrid-3axis.yaml";
 
-TEST_F(Cli, PlansTheBracketAndWritesPlanJsonWithValidPlans) {
-  const Outcome r = run({"plan", "--no-validate", kBracket, "--machine", kMachine, "--voxel", "1", "-o", (dir_ / "plan").string()});
+TEST_F(Cli, PlansTheFlangedHubAndWritesPlanJsonWithValidPlans) {
+  const Outcome r = run({"plan", "--no-validate", kFlangedHub, "--machine", kMachine, "--voxel", "1", "-o", (dir_ / "plan").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("verdict     manufacturable"), std::string::npos) << r.out;
   const std::string json = slurp(dir_ / "plan" / "plan.json");
@@ -164,7 +165,21 @@ TEST_F(Cli, PlansTheBracketAndWritesPlanJsonWithValidPlans) {
   EXPECT_TRUE(fs::exists(dir_ / "plan" / "primitives" / "P1.vdb"));
   EXPECT_TRUE(fs::exists(dir_ / "plan" / "plans" / "plan-1.vdb"));
   // Planning again over the earlier output replaces it.
-  EXPECT_EQ(run({"plan", "--no-validate", kBracket, "--machine", kMachine, "--voxel", "1", "--top", "2", "-o", (dir_ / "plan").string()}).exit_code, 0);
+  EXPECT_EQ(run({"plan", "--no-validate", kFlangedHub, "--machine", kMachine, "--voxel", "1", "--top", "2", "-o", (dir_ / "plan").string()}).exit_code, 0);
+}
+
+// The bracket's horizontal hole has a roof that no deposit from +Z holds up (it overhangs
+// far past the head's 30 degrees) and that a deposit from -Z, turned over, could only lay
+// under the material already there. The planner proves that no order of its primitives
+// makes the part and names the roof, without offering validation a plan that must fail.
+TEST_F(Cli, TheBracketIsProvenNotManufacturableOnTheThreeAxisMachineAndTheHoleRoofIsNamed) {
+  const Outcome r = run({"plan", kBracket, "--machine", kMachine, "--voxel", "1"});
+  EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
+  EXPECT_NE(r.out.find("verdict     NOT manufacturable: no sequence of these primitives makes the design"), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("0 candidates rejected"), std::string::npos) << r.out;
+  // The roof of the 10 mm hole through the wall (x 0..10, y 20, z 35): its top is at z 40.
+  EXPECT_NE(r.out.find("around (5.0, 20.0, 40."), std::string::npos) << r.out;
 }
 
 TEST_F(Cli, PlanRefusesToReplaceADirectoryThatIsNotAPlan) {

@@ -60,20 +60,26 @@ TEST_F(Export, EveryProgramForTheExamplePartsPassesRs274AndOurCheck) {
   }
 }
 
-// The bracket has no plan that makes it on the bundled machine (the roof of its horizontal
-// hole can be neither deposited nor milled from +-Z). Planned without validation, its best
-// plan is offered, but export executes it and refuses it: exit 4, the reasons, and nothing
-// written.
-TEST_F(Export, APlanThatDoesNotMakeItsPartIsRefusedAndNothingIsWritten) {
-  const std::string machine = (kSource / "examples/machines/hybrid-3axis.yaml").string();
+// A plan planned for a machine whose X travel is too short for the part where its setup
+// holds it: export posts the program, finds the first move beyond the travel and writes
+// nothing (exit 3, the action, the line and the axis). The bracket, which export refused
+// here before, has no plan at all now: `plan` proves that no order of the primitives makes
+// it (Cli.TheBracketIsProvenNotManufacturable...).
+TEST_F(Export, APlanThatLeavesTheMachineEnvelopeIsRefusedAndNothingIsWritten) {
+  std::string yaml = slurp(kSource / "examples/machines/hybrid-3axis.yaml");
+  const std::string travel = "X: {travel: [0, 400]";
+  ASSERT_NE(yaml.find(travel), std::string::npos);
+  yaml.replace(yaml.find(travel), travel.size(), "X: {travel: [0, 235]");  // the hub reaches X 250 from work origin 200
+  const fs::path machine = dir_ / "short-x.yaml";
+  std::ofstream(machine) << yaml;
   const fs::path plan = dir_ / "plan";
-  const Outcome planned = hybridctl({"plan", "--no-validate", (kSource / "examples/parts/bracket.stl").string(), "--machine",
-                                     machine, "--voxel", "0.5", "--top", "1", "-o", plan.string()});
+  const Outcome planned = hybridctl({"plan", "--no-validate", (kSource / "examples/parts/flanged-hub.stl").string(), "--machine",
+                                     machine.string(), "--voxel", "0.5", "--top", "1", "-o", plan.string()});
   ASSERT_EQ(planned.exit_code, 0) << planned.out << planned.err;
   const Outcome exported = hybridctl({"export", plan.string(), "--plan", "1", "-o", (dir_ / "out").string()});
-  EXPECT_EQ(exported.exit_code, 4) << exported.out << exported.err;
+  EXPECT_EQ(exported.exit_code, 3) << exported.out << exported.err;
   EXPECT_FALSE(fs::exists(dir_ / "out")) << "export wrote a refused plan";
-  EXPECT_NE((exported.out + exported.err).find("layer_skipped"), std::string::npos) << exported.out << exported.err;
+  EXPECT_NE(exported.err.find("beyond the X travel [0, 235]; nothing was written"), std::string::npos) << exported.err;
 }
 
 TEST_F(Export, AFanucProgramHasItsMarksAndParsesBack) {

@@ -1,7 +1,7 @@
 // The plan in memory is the plan on disk: to_plan_file(result) equals what
 // read_plan_file gives back from the directory write_plan_directory(result) wrote, down to
 // where each solid stores its voxels (the simulation's domain is a stock's storage box).
-// The bundled bracket on the bundled hybrid machine, at a coarse 1 mm voxel.
+// The flanged hub on the bundled hybrid machine, at a coarse 1 mm voxel.
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -29,13 +29,13 @@ void expect_same_storage(const geometry::Solid& memory, const geometry::Solid& d
 TEST(PlanInMemory, EqualsThePlanReadBackFromItsDirectory) {
   const std::string machine_text = config::read_machine_text(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
   const config::Machine machine = config::parse_machine(machine_text, "hybrid-3axis.yaml");
-  const geometry::TriangleMesh part = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/bracket.stl");
+  const geometry::TriangleMesh part = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/flanged-hub.stl");
   PlanningOptions options;
   options.voxel_size = 1.0;
   options.top_k = 3;
-  const PlanningResult result = plan_part(part, "bracket.stl", machine, options);
+  const PlanningResult result = plan_part(part, "flanged-hub.stl", machine, options);
   ASSERT_FALSE(result.plans.empty());
-  const ReportSources sources{"bracket.stl", "hybrid-3axis.yaml", machine.name, machine_text};
+  const ReportSources sources{"flanged-hub.stl", "hybrid-3axis.yaml", machine.name, machine_text};
   const fs::path dir = fs::temp_directory_path() / ("hybridctl-plan-in-memory-" + std::to_string(::getpid()));
   write_plan_directory(result, sources, dir);
   const PlanFile disk = read_plan_file(dir);
@@ -71,11 +71,11 @@ TEST(PlanInMemory, EqualsThePlanReadBackFromItsDirectory) {
 TEST(PlanInMemory, RejectedCandidatesAreKeptWithTheirReasonsAndReadBack) {
   const std::string machine_text = config::read_machine_text(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
   const config::Machine machine = config::parse_machine(machine_text, "hybrid-3axis.yaml");
-  const geometry::TriangleMesh part = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/bracket.stl");
+  const geometry::TriangleMesh part = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/flanged-hub.stl");
   PlanningOptions options;
   options.voxel_size = 1.0;
   options.top_k = 2;
-  const PlanningResult unvalidated = plan_part(part, "bracket.stl", machine, options);
+  const PlanningResult unvalidated = plan_part(part, "flanged-hub.stl", machine, options);
   ASSERT_EQ(unvalidated.plans.size(), 2u);
   int offered = 0;
   options.validate = [&offered](const PlanningResult&, const Plan&) {
@@ -85,7 +85,7 @@ TEST(PlanInMemory, RejectedCandidatesAreKeptWithTheirReasonsAndReadBack) {
     if (offered == 2) return std::vector<RejectionReason>{{"missing_material", 0, 0, "the fin is missing", std::nullopt}};
     return std::vector<RejectionReason>{};
   };
-  const PlanningResult result = plan_part(part, "bracket.stl", machine, options);
+  const PlanningResult result = plan_part(part, "flanged-hub.stl", machine, options);
   EXPECT_TRUE(result.validated);
   ASSERT_EQ(result.rejected.size(), 2u);
   ASSERT_EQ(result.plans.size(), 2u);
@@ -94,7 +94,7 @@ TEST(PlanInMemory, RejectedCandidatesAreKeptWithTheirReasonsAndReadBack) {
   EXPECT_GE(result.plans[0].cost, unvalidated.plans[1].cost);
   EXPECT_EQ(offered, 4);
 
-  const ReportSources sources{"bracket.stl", "hybrid-3axis.yaml", machine.name, machine_text};
+  const ReportSources sources{"flanged-hub.stl", "hybrid-3axis.yaml", machine.name, machine_text};
   const fs::path dir = fs::temp_directory_path() / ("hybridctl-plan-rejected-" + std::to_string(::getpid()));
   write_plan_directory(result, sources, dir);
   const PlanFile disk = read_plan_file(dir);

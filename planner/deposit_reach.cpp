@@ -1,0 +1,167 @@
+#include "planner/deposit_reach.hpp"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <cstdint>
+
+namespace hybridctl::planner {
+
+std::vector<AtomSet> atoms_above(const AtomDecomposition& atoms, geometry::AxisDirection approach, int gap) {
+  const int n = atoms.atom_count();
+  std::vector<AtomSet> above(static_cast<std::size_t>(n));
+  const geometry::IndexBox& d = atoms.domain();
+  if (d.empty()) return above;
+  // Lattice coordinates of (u, v) across the column and t along it, towards the head.
+  const geometry::Index3 lo = d.lo, hi = d.hi;
+  const int axis = approach.axis == geometry::Axis::X ? 0 : approach.axis == geometry::Axis::Y ? 1 : 2;
+  const int lo3[3] = {lo.x, lo.y, lo.z}, hi3[3] = {hi.x, hi.y, hi.z};
+  const int ua = (axis + 1) % 3, va = (axis + 2) % 3;
+  const int len = hi3[axis] - lo3[axis];
+  struct Run {
+    int atom, first, last;  // positions along the column, from the far side
+  };
+  std::vector<Run> runs;
+  for (int v = lo3[va]; v < hi3[va]; ++v)
+    for (int u = lo3[ua]; u < hi3[ua]; ++u) {
+      runs.clear();
+      for (int t = 0; t < len; ++t) {
+        int c[3];
+        c[ua] = u, c[va] = v;
+        c[axis] = approach.sign > 0 ? lo3[axis] + t : hi3[axis] - 1 - t;
+        const int a = atoms.atom_at_unchecked(c[0] - lo.x, c[1], c[2]);
+        if (!runs.empty() && runs.back().atom == a)
+          runs.back().last = t;
+        else
+          runs.push_back({a, t, t});
+      }
+      // Run j lies above run i; some voxel of j is `gap` above some voxel of i when j's
+      // last reaches i's first plus the gap.
+      for (std::size_t i = 0; i < runs.size(); ++i)
+        for (std::size_t j = i + 1; j < runs.size(); ++j) {
+          if (runs[j].atom == runs[i].atom || runs[j].last < runs[i].first + gap) continue;
+          AtomSet& s = above[std::size_t(runs[i].atom)];
+          if (s.words().empty()) s = AtomSet(n);
+          s.set(runs[j].atom);
+        }
+    }
+  return above;
+}
+
+namespace {
+
+// A domain seen along a build axis: columns (u, v) across it, t along it towards the head.
+struct ColumnFrame {
+  int axis, ua, va, sign;
+  int lo[3], hi[3];
+  ColumnFrame(const geometry::IndexBox& d, geometry::AxisDirection approach)
+      : axis(approach.axis == geometry::Axis::X ? 0 : approach.axis == geometry::Axis::Y ? 1 : 2),
+        ua((axis + 1) % 3),
+        va((axis + 2) % 3),
+        sign(approach.sign),
+        lo{d.lo.x, d.lo.y, d.lo.z},
+        hi{d.hi.x, d.hi.y, d.hi.z} {}
+  int nu() const { return hi[ua] - lo[ua]; }
+  int nv() const { return hi[va] - lo[va]; }
+  int length() const { return hi[axis] - lo[axis]; }
+  int atom(const AtomDecomposition& atoms, int u, int v, int t) const {
+    int c[3];
+    c[ua] = lo[ua] + u, c[va] = lo[va] + v;
+    c[axis] = sign > 0 ? lo[axis] + t : hi[axis] - 1 - t;
+    return atoms.atom_at_unchecked(c[0] - lo[0], c[1], c[2]);
+  }
+};
+
+}  // namespace
+
+std::vector<AtomSet> atoms_in_nozzle_reach(const AtomDecomposition& atoms, geometry::AxisDirection approach,
+                                           const NozzleReach& nozzle) {
+  const int n = atoms.atom_count();
+  std::vector<AtomSet> reach(static_cast<std::size_t>(n));
+  if (atoms.domain().empty() || nozzle.radius <= 0) return reach;
+  const ColumnFrame f(atoms.domain(), approach);
+  const int nu = f.nu(), nv = f.nv(), len = f.length();
+  if (len > nozzle.standoff + nozzle.length) return reach;
+  // Per column the atoms in it with their lowest and highest voxel along the build axis,
+  // and per atom its columns' box.
+  constexpr int kNone = -1;
+  struct Entry {
+    int atom, lowest, highest;
+  };
+  std::vector<std::vector<Entry>> in_column(std::size_t(nu) * std::size_t(nv));
+  struct Box2 {
+    int u0 = INT32_MAX, v0 = INT32_MAX, u1 = -1, v1 = -1;
+  };
+  std::vector<Box2> box(static_cast<std::size_t>(n));
+  for (int v = 0; v < nv; ++v)
+    for (int u = 0; u < nu; ++u) {
+      auto& column = in_column[std::size_t(v) * std::size_t(nu) + std::size_t(u)];
+      for (int t = 0; t < len; ++t) {
+        const int a = f.atom(atoms, u, v, t);
+        const auto e = std::find_if(column.begin(), column.end(), [a](const Entry& x) { return x.atom == a; });
+        if (e != column.end()) {
+          e->highest = t;
+          continue;
+        }
+        column.push_back({a, t, t});
+        Box2& b = box[std::size_t(a)];
+        b.u0 = std::min(b.u0, u), b.v0 = std::min(b.v0, v), b.u1 = std::max(b.u1, u), b.v1 = std::max(b.v1, v);
+      }
+    }
+  std::vector<int> highest;
+  // Half the side of the square inscribed in the body's circle, in whole voxels.
+  const int half = int(std::floor(nozzle.radius / std::sqrt(2.0) + 1e-9));
+  std::vector<int> row, top;
+  for (int a = 0; a < n; ++a) {
+    const Box2& b = box[std::size_t(a)];
+    if (b.u1 < 0) continue;
+    // The highest voxel of `a` within the square around each column (a separable max).
+    const int u0 = std::max(0, b.u0 - half), u1 = std::min(nu - 1, b.u1 + half);
+    const int v0 = std::max(0, b.v0 - half), v1 = std::min(nv - 1, b.v1 + half);
+    const int wu = u1 - u0 + 1, wv = v1 - v0 + 1;
+    const int bu = b.u1 - b.u0 + 1;
+    highest.assign(std::size_t(bu) * std::size_t(b.v1 - b.v0 + 1), kNone);
+    for (int v = b.v0; v <= b.v1; ++v)
+      for (int u = b.u0; u <= b.u1; ++u)
+        for (const Entry& e : in_column[std::size_t(v) * std::size_t(nu) + std::size_t(u)])
+          if (e.atom == a) highest[std::size_t(v - b.v0) * std::size_t(bu) + std::size_t(u - b.u0)] = e.highest;
+    row.assign(std::size_t(wu) * std::size_t(wv), kNone);
+    for (int v = b.v0; v <= b.v1; ++v)
+      for (int u = u0; u <= u1; ++u) {
+        int m = kNone;
+        for (int k = std::max(b.u0, u - half); k <= std::min(b.u1, u + half); ++k)
+          m = std::max(m, highest[std::size_t(v - b.v0) * std::size_t(bu) + std::size_t(k - b.u0)]);
+        row[std::size_t(v - v0) * std::size_t(wu) + std::size_t(u - u0)] = m;
+      }
+    top.assign(row.size(), kNone);
+    for (int v = v0; v <= v1; ++v)
+      for (int u = u0; u <= u1; ++u) {
+        int m = kNone;
+        for (int k = std::max(b.v0, v - half); k <= std::min(b.v1, v + half); ++k)
+          m = std::max(m, row[std::size_t(k - v0) * std::size_t(wu) + std::size_t(u - u0)]);
+        top[std::size_t(v - v0) * std::size_t(wu) + std::size_t(u - u0)] = m;
+      }
+    // Every atom with a voxel the body over it would reach `a` from.
+    for (int v = v0; v <= v1; ++v)
+      for (int u = u0; u <= u1; ++u) {
+        const int t = top[std::size_t(v - v0) * std::size_t(wu) + std::size_t(u - u0)];
+        if (t == kNone) continue;
+        for (const Entry& e : in_column[std::size_t(v) * std::size_t(nu) + std::size_t(u)]) {
+          const int other = e.atom;
+          if (other == a || t < e.lowest + nozzle.standoff) continue;
+          AtomSet& s = reach[std::size_t(other)];
+          if (s.words().empty()) s = AtomSet(n);
+          s.set(a);
+        }
+      }
+  }
+  return reach;
+}
+
+int deposit_reach_gap(double layer_height, double voxel_size) {
+  // A layer holds at most floor(layer / h) + 1 voxel centres: material that many voxels
+  // up lies in a later layer.
+  return int(std::floor(layer_height / voxel_size + 1e-9)) + 1;
+}
+
+}  // namespace hybridctl::planner

@@ -1,0 +1,42 @@
+#pragma once
+// What material already present keeps a head from depositing an atom. A head deposits
+// from its setup's approach side, layer on layer towards itself; a voxel with material
+// above it (towards the head) in its column cannot be reached: the toolpath skips that
+// part of the layer (toolpaths/deposition_path.cpp, "layer_skipped") and validation
+// rejects the plan. The search uses this relation to leave such actions out, so that it
+// does not offer validation plans that can only fail (e.g. deposit from +Z, turn the part
+// over, deposit from -Z under what is there).
+
+#include <vector>
+
+#include "geometry/morphology.hpp"
+#include "planner/atom_set.hpp"
+#include "planner/atoms.hpp"
+
+namespace hybridctl::planner {
+
+// For each atom b, the atoms a with a voxel `gap` or more voxels above a voxel of b in one
+// column along `approach` (above: towards the approach side). With the gap of
+// deposit_reach_gap, material that may lie in the same layer as b, which the toolpath
+// still reaches, stays out of the relation. Atoms with nothing above them get an empty set (no words).
+std::vector<AtomSet> atoms_above(const AtomDecomposition& atoms, geometry::AxisDirection approach, int gap);
+
+// The nozzle body a head carries over the point it deposits at: a cylinder of `radius`
+// from `standoff` to `standoff + length` above it (instruments/bead.hpp), in voxels.
+struct NozzleReach {
+  double radius = 0;
+  int standoff = 0, length = 0;
+};
+
+// For each atom b, the atoms a with a voxel inside the nozzle body placed over some voxel
+// of b: present, they meet the nozzle when the head deposits b (the simulator's
+// body_collision). The body is taken as the square inscribed in its circle (never more
+// than the nozzle), and when the domain is taller than the body's top along `approach`
+// the relation is left empty, as it ignores how far up the body ends.
+std::vector<AtomSet> atoms_in_nozzle_reach(const AtomDecomposition& atoms, geometry::AxisDirection approach,
+                                           const NozzleReach& nozzle);
+
+// The gap for a head's layer height on a lattice of voxel size h: floor(layer / h) + 1.
+int deposit_reach_gap(double layer_height, double voxel_size);
+
+}  // namespace hybridctl::planner

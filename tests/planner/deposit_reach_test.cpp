@@ -1,0 +1,132 @@
+// A head deposits towards itself, layer on layer: material already there above an atom
+// (towards the head) keeps the head from it. The search leaves such actions out, so a
+// column made of two deposits from opposite sides cannot be made in either order.
+
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "planner/deposit_reach.hpp"
+#include "planner_fixtures.hpp"
+
+namespace hybridctl::planner {
+namespace {
+
+using geometry::Axis;
+using geometry::AxisDirection;
+using geometry::make_box;
+using testing::make_problem;
+using testing::VoxelPrimitive;
+using testing::VoxelProblem;
+
+const Lattice kUnit{1.0, {0, 0, 0}};
+const IndexBox kDomain{{0, 0, 0}, {4, 1, 10}};
+constexpr AxisDirection kFromAbove{Axis::Z, +1}, kFromBelow{Axis::Z, -1};
+
+Solid slab(double z0, double z1) { return make_box(kUnit, {{0, 0, z0}, {4, 1, z1}}); }
+
+int atom_at(const VoxelProblem& vp, int z) { return vp.atoms.atom_at({1, 0, z}); }
+
+// Deposits of the column's lower and upper part, each from `lower_from` and `upper_from`,
+// with the relation atoms_above gives each side.
+VoxelProblem column(AxisDirection lower_from, AxisDirection upper_from) {
+  VoxelProblem vp = make_problem({{"lower", Mode::Additive, false, 1.0, slab(0, 6)}, {"upper", Mode::Additive, false, 1.0, slab(4, 10)}},
+                                 slab(0, 10), kDomain);
+  vp.problem.primitives[0].blocked_by = std::make_shared<const std::vector<AtomSet>>(atoms_above(vp.atoms, lower_from, 1));
+  vp.problem.primitives[1].blocked_by = std::make_shared<const std::vector<AtomSet>>(atoms_above(vp.atoms, upper_from, 1));
+  return vp;
+}
+
+TEST(AtomsAbove, AreTheAtomsTowardsTheHeadInAColumn) {
+  const VoxelProblem vp = column(kFromAbove, kFromAbove);
+  ASSERT_EQ(vp.atoms.atom_count(), 3);
+  const int bottom = atom_at(vp, 0), middle = atom_at(vp, 5), top = atom_at(vp, 9);
+  const auto from_above = atoms_above(vp.atoms, kFromAbove, 1);
+  EXPECT_TRUE(from_above[std::size_t(bottom)].test(middle));
+  EXPECT_TRUE(from_above[std::size_t(bottom)].test(top));
+  EXPECT_TRUE(from_above[std::size_t(middle)].test(top));
+  EXPECT_FALSE(from_above[std::size_t(middle)].test(bottom));
+  EXPECT_TRUE(from_above[std::size_t(top)].words().empty()) << "nothing lies above the top";
+  const auto from_below = atoms_above(vp.atoms, kFromBelow, 1);
+  EXPECT_TRUE(from_below[std::size_t(top)].test(bottom));
+  EXPECT_TRUE(from_below[std::size_t(bottom)].words().empty());
+}
+
+TEST(AtomsAbove, LeaveOutMaterialCloserThanTheGap) {
+  // Two one-voxel layers: the upper lies in the same deposition layer as the lower.
+  const VoxelProblem vp =
+      make_problem({{"a", Mode::Additive, false, 1.0, slab(0, 1)}, {"b", Mode::Additive, false, 1.0, slab(1, 2)}}, slab(0, 2),
+                   {{0, 0, 0}, {4, 1, 2}});
+  const int a = atom_at(vp, 0), b = atom_at(vp, 1);
+  EXPECT_TRUE(atoms_above(vp.atoms, kFromAbove, 1)[std::size_t(a)].test(b));
+  EXPECT_TRUE(atoms_above(vp.atoms, kFromAbove, 2)[std::size_t(a)].words().empty());
+  EXPECT_EQ(deposit_reach_gap(0.6, 0.5), 2) << "a 0.6 mm layer holds at most two 0.5 mm voxel centres";
+  EXPECT_EQ(deposit_reach_gap(1.0, 1.0), 2);
+  EXPECT_EQ(deposit_reach_gap(0.6, 2.0), 1) << "a voxel up is a later layer";
+}
+
+// A tall wall beside a low pad: depositing the pad from above, the nozzle body (radius 10,
+// from 5 above the bead) reaches over the wall when the wall stands within the square
+// inscribed in the body's circle (7 voxels), and does not when it stands farther.
+VoxelProblem wall_and_pad(double wall_to) {
+  const Solid wall = make_box(kUnit, {{0, 0, 0}, {wall_to, 1, 20}}), pad = make_box(kUnit, {{10, 0, 0}, {14, 1, 2}});
+  return make_problem({{"wall", Mode::Additive, false, 1.0, wall}, {"pad", Mode::Additive, false, 1.0, pad}}, unite(wall, pad),
+                      {{0, 0, 0}, {30, 1, 30}});
+}
+
+TEST(AtomsInNozzleReach, AreTheAtomsTheBodyMeetsOverTheDeposit) {
+  const NozzleReach nozzle{10, 5, 60};
+  const VoxelProblem near = wall_and_pad(4);  // the wall's last column, x 3, is 7 from the pad's first
+  const int wall = near.atoms.atom_at({1, 0, 5}), pad = near.atoms.atom_at({11, 0, 0});
+  const auto reach = atoms_in_nozzle_reach(near.atoms, kFromAbove, nozzle);
+  ASSERT_FALSE(reach[std::size_t(pad)].words().empty());
+  EXPECT_TRUE(reach[std::size_t(pad)].test(wall));
+  EXPECT_TRUE(reach[std::size_t(wall)].words().empty() || !reach[std::size_t(wall)].test(pad))
+      << "the pad is lower than the standoff over the wall's foot";
+
+  const VoxelProblem far = wall_and_pad(2);  // x 1: 9 from the pad
+  const int far_pad = far.atoms.atom_at({11, 0, 0}), far_wall = far.atoms.atom_at({1, 0, 5});
+  const auto far_reach = atoms_in_nozzle_reach(far.atoms, kFromAbove, nozzle);
+  EXPECT_TRUE(far_reach[std::size_t(far_pad)].words().empty() || !far_reach[std::size_t(far_pad)].test(far_wall));
+
+  // A body shorter than the domain is tall: the relation does not know where it ends.
+  for (const AtomSet& s : atoms_in_nozzle_reach(near.atoms, kFromAbove, {10, 5, 20})) EXPECT_TRUE(s.words().empty());
+}
+
+TEST(DepositReach, BothFromAboveOnlyTheLowerPartFirst) {
+  const VoxelProblem vp = column(kFromAbove, kFromAbove);
+  const auto plans = find_plans(vp.problem, {5});
+  ASSERT_EQ(plans.size(), 1u) << "the upper part first would leave the lower under it";
+  EXPECT_EQ(expression(vp.problem, plans[0]), "(lower \u222A upper)");
+  EXPECT_EQ(enumerate_plans(vp.problem).size(), 1u);
+  const Reachability reach = explore_reachable(vp.problem);
+  EXPECT_TRUE(reach.goal);
+  EXPECT_DOUBLE_EQ(reach.wrong_volume, 0);
+}
+
+TEST(DepositReach, FromOppositeSidesNoOrderMakesTheColumnAndExplorationProvesIt) {
+  const VoxelProblem vp = column(kFromAbove, kFromBelow);
+  EXPECT_TRUE(find_plans(vp.problem, {5}).empty());
+  EXPECT_TRUE(enumerate_plans(vp.problem).empty());
+  const Reachability reach = explore_reachable(vp.problem);
+  EXPECT_TRUE(reach.complete);
+  EXPECT_FALSE(reach.goal);
+  EXPECT_EQ(reach.states, 2) << "each part alone";
+  EXPECT_DOUBLE_EQ(reach.wrong_volume, 4.0 * 4) << "the nearest lacks 4 of the 10 layers";
+
+  // Without the relation both orders make it: the search needs it to see the deadlock.
+  VoxelProblem blind = vp;
+  for (PrimitiveSpec& p : blind.problem.primitives) p.blocked_by.reset();
+  EXPECT_EQ(find_plans(blind.problem, {5}).size(), 2u);
+  EXPECT_TRUE(explore_reachable(blind.problem).goal);
+}
+
+TEST(DepositReach, ExplorationStopsAtItsStateLimitUndecided) {
+  const VoxelProblem vp = column(kFromAbove, kFromBelow);
+  const Reachability reach = explore_reachable(vp.problem, 1);
+  EXPECT_FALSE(reach.complete);
+  EXPECT_FALSE(reach.goal);
+}
+
+}  // namespace
+}  // namespace hybridctl::planner
