@@ -83,8 +83,6 @@ int export_plan_programs(const planner::PlanFile& file, const ExportRequest& req
               "%.2f mm (tolerance %.2f mm, %s)\n",
               run.program.lines.size(), d.over_volume, d.under_volume, d.worst_distance, file.tolerance,
               d.within_tolerance ? "within" : "OUTSIDE");
-  for (const planner::RejectionReason& r : run.reasons)
-    std::printf("  warning: %s: %s\n", r.kind.c_str(), planner::describe(r).c_str());
   std::printf("wrote       %s, %zu action programs and tool.tbl in %s\n", written.program.filename().string().c_str(),
               written.actions.size(), request.output.c_str());
   return kSuccess;

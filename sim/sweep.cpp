@@ -129,14 +129,23 @@ std::vector<ConvexPiece> pieces_of(const Bead& bead) {
   p.from = 0;
   p.to = bead.height;
   p.radius = bead.width / 2;
-  if (bead.shape == config::BeadShape::Ellipsoid) {
-    p.kind = ConvexPiece::Kind::Ellipsoid;
-    p.centre = bead.height / 2;
-    p.half_height = bead.height / 2;
-  } else {
+  if (bead.shape != config::BeadShape::Ellipsoid) {
     p.kind = ConvexPiece::Kind::Cylinder;
+    return {p};
   }
-  return {p};
+  p.kind = ConvexPiece::Kind::Ellipsoid;
+  p.centre = bead.height / 2;
+  p.half_height = bead.height / 2;
+  // The molten bead wets what it is laid on and fills the valleys between the tracks and
+  // layers below: below its widest line it is as wide as that line (docs/simulation.md).
+  // Ellipses alone leave a void where four overlapping beads meet, which no real
+  // deposit has.
+  ConvexPiece lower;
+  lower.kind = ConvexPiece::Kind::Cylinder;
+  lower.from = 0;
+  lower.to = bead.height / 2;
+  lower.radius = bead.width / 2;
+  return {p, lower};
 }
 
 PieceSweep::PieceSweep(const ConvexPiece& piece, const Segment& segment, const geometry::Lattice& lattice)

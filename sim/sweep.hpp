@@ -56,7 +56,9 @@ struct ConvexPiece {
 // Throws std::invalid_argument for a negative or non-finite radius or an infinite
 // non-cylinder section.
 std::vector<ConvexPiece> pieces_of(std::span<const geometry::AxialSection> sections);
-// The bead's shape as one piece (its body is not included). Throws
+// The bead's shape (its body is not included): a cylinder bead as one piece, an
+// ellipsoid bead as the ellipsoid and, below its widest line, the cylinder of its width
+// (the bead fills the valleys it is laid in). Throws
 // std::invalid_argument unless width and height are positive.
 std::vector<ConvexPiece> pieces_of(const Bead& bead);
 

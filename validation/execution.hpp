@@ -103,16 +103,9 @@ std::string reason_kind(sim::IncidentKind kind);
 // The reasons as lines for people, at most `shown` of them and a count of the rest.
 std::string describe_reasons(const std::vector<planner::RejectionReason>& reasons, std::size_t shown = 20);
 
-// Whether a reason stops export and run from writing or streaming the plan: path defects
-// (layer_skipped, unreachable), rapids and bodies into material, gouges, refused lines.
-// Deposit over air and a part out of tolerance reject candidates in `plan` but are
-// warnings for a plan given to export (the machine answers a bead over air with a warning
-// alarm).
-bool refuses_output(const planner::RejectionReason& reason);
-
 // execute_plan, and a NotManufacturableError (exit 4) naming `what` ("plan 2 (expr)") and
-// every reason when a reason refuses output: export and run write or stream nothing then.
-// The other reasons stay in the execution's `reasons` for the caller to warn about.
+// every reason when there is any (the plan does not make its part, or is unsafe to run):
+// export and run write or stream nothing then.
 Execution require_proven(const planner::PlanFile& file, const planner::PlanFilePlan& plan,
                          const config::Machine& machine, const ExecutionOptions& options, const std::string& what);
 

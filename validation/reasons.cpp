@@ -116,22 +116,14 @@ std::string describe_reasons(const std::vector<RejectionReason>& reasons, std::s
   return out;
 }
 
-bool refuses_output(const RejectionReason& reason) {
-  // What the machine must never be given: a path that skips what it should make, a
-  // rapid or a body into material, a cut into the part, a line it refuses. The rest
-  // (deposit over air, which the machine answers with a warning alarm, and the part out
-  // of tolerance) rejects a candidate in `plan` but is a warning for a plan given to export.
-  static const char* const kinds[] = {"layer_skipped", "unreachable",  "rapid_into_material", "body_collision",
-                                      "nozzle_collision", "gouge", "refused_line", "not_exportable"};
-  return std::any_of(std::begin(kinds), std::end(kinds), [&](const char* k) { return reason.kind == k; });
-}
-
 Execution require_proven(const planner::PlanFile& file, const planner::PlanFilePlan& plan,
                          const config::Machine& machine, const ExecutionOptions& options, const std::string& what) {
   Execution run = execute_plan(file, plan, machine, options);
-  std::vector<RejectionReason> refused;
-  std::copy_if(run.reasons.begin(), run.reasons.end(), std::back_inserter(refused), refuses_output);
-  if (!refused.empty())
+  // Every reason refuses: a path that skips what it should make, a rapid or a body into
+  // material, a cut into the part, a line the machine refuses, a bead over air that falls,
+  // a part out of tolerance. Each means the part comes off the machine wrong or the
+  // machine is put at risk.
+  if (!run.reasons.empty())
     throw NotManufacturableError(what + " is not safe to run or does not make the part when executed from the raw "
                                  "stock (" + std::to_string(run.reasons.size()) + " reason" +
                                  (run.reasons.size() == 1 ? "" : "s") + "); nothing written:\n" +

@@ -223,7 +223,7 @@ def pick_plan(plan_dir):
 
 
 def pick_deposit_plan(plan_dir):
-    """The first plan that only deposits (the flanged hub from -Z, unvalidated): a program
+    """The first plan that only deposits (the flanged hub from -Z, validated): a program
     that switches the deposition output on and off thousands of times."""
     doc = json.load(open(os.path.join(plan_dir, "plan.json")))
     names = {p["name"]: p.get("label", "") for p in doc["primitives"]}

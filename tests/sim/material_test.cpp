@@ -309,8 +309,11 @@ TEST(MaterialSimulation, ABeadDepositsItsSweptVolume) {
     MaterialSimulation sim(Solid(kFine, kPlateBox));
     const Bead bead{config::BeadShape::Ellipsoid, 2, 1, {}, {}};
     const MoveReport r = sim.deposit(bead, {Motion::Linear, {2, 3, 0}, {2 + length, 3, 0}, {}, true, 50});
-    // An elliptic cylinder with half an ellipsoid at each end.
-    const double expected = std::numbers::pi * 1 * 0.5 * length + 4.0 / 3 * std::numbers::pi * 1 * 1 * 0.5;
+    // Its upper half an elliptic cylinder with a quarter ellipsoid at each end, its lower
+    // half (below the widest line, 0.5 mm) a box with half a round slab at each end.
+    const double upper = std::numbers::pi * 1 * 0.5 / 2 * length + 2.0 / 3 * std::numbers::pi * 1 * 1 * 0.5;
+    const double lower = 2 * 1 * 0.5 * length + std::numbers::pi * 1 * 1 * 0.5;
+    const double expected = upper + lower;
     EXPECT_NEAR(r.deposited, expected, 0.02 * expected);
     EXPECT_DOUBLE_EQ(r.deposited, sim.stock().volume());
     EXPECT_EQ(r.overlap, 0);

@@ -44,7 +44,7 @@ const Planned& planned() {
     const auto mesh = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/flanged-hub.stl");
     planner::PlanningOptions options;
     options.voxel_size = 0.5;
-    options.top_k = 6;
+    options.top_k = 10;  // plan 9 deposits the hub from -Z and mills it
     const planner::PlanningResult r = planner::plan_part(mesh, "flanged-hub.stl", out.machine, options);
     const fs::path dir = fs::temp_directory_path() / ("hybridctl-replay-" + std::to_string(::getpid()));
     planner::write_plan_directory(r, {"flanged-hub.stl", "hybrid-3axis.yaml", out.machine.name, ""}, dir);

@@ -54,11 +54,14 @@ inline ShapeTest sections_shape(std::vector<AxialSection> sections, double delta
   };
 }
 
-// An ellipsoid bead anchored at its bottom, semi-axes grown by `delta`.
+// An ellipsoid bead anchored at its bottom, with the cylinder of its width below its
+// widest line (the bead fills the valleys it is laid in), grown by `delta`.
 inline ShapeTest ellipsoid_bead_shape(double width, double height, double delta = 0) {
   const double a = width / 2 + delta, b = height / 2 + delta, c = height / 2;
   return [=](double qx, double qy, double qz) {
-    return (qx * qx + qy * qy) / (a * a) + (qz - c) * (qz - c) / (b * b) <= 1;
+    const double rho2 = qx * qx + qy * qy;
+    if (qz >= -delta && qz <= c && rho2 <= a * a) return true;
+    return rho2 / (a * a) + (qz - c) * (qz - c) / (b * b) <= 1;
   };
 }
 

@@ -82,15 +82,19 @@ TEST(SweptVolume, AxisAlignedMovesEqualTheDilationOfTheirPath) {
 }
 
 TEST(SweptVolume, LevelBeadMovesEqualTheDilationOfTheirPath) {
-  // Ellipsoid 2 x 1 mm: centre 0.5 mm = one voxel above the programmed (bottom) point.
+  // Ellipsoid 2 x 1 mm: centre 0.5 mm = one voxel above the programmed (bottom) point,
+  // and below it the cylinder of its width.
   const Bead ellipsoid{config::BeadShape::Ellipsoid, 2.0, 1.0, {}, {}};
   const Bead cylinder{config::BeadShape::Cylinder, 2.5, 1.5, {}, {}};
   for (const auto& [a, b] : std::vector<std::pair<geometry::Index3, geometry::Index3>>{
            {{2, 4, 3}, {15, 4, 3}}, {{3, 15, 0}, {3, 2, 0}}, {{7, 7, 7}, {7, 7, 7}}}) {
     const Solid path = path_voxels(a, b);
-    const Solid expected_ellipsoid = geometry::translate(
-        geometry::dilate(path, geometry::Ellipsoid{{1.0, 1.0, 0.5}}, kDomain, geometry::MorphologyMethod::BruteForce),
-        {0, 0, 1});
+    const Solid expected_ellipsoid = geometry::unite(
+        geometry::translate(
+            geometry::dilate(path, geometry::Ellipsoid{{1.0, 1.0, 0.5}}, kDomain, geometry::MorphologyMethod::BruteForce),
+            {0, 0, 1}),
+        geometry::dilate(path, geometry::cylinder_body({geometry::Axis::Z, +1}, 1.0, 0.5), kDomain,
+                         geometry::MorphologyMethod::BruteForce));
     const Solid expected_cylinder = geometry::dilate(path, geometry::cylinder_body({geometry::Axis::Z, +1}, 1.25, 1.5),
                                                      kDomain, geometry::MorphologyMethod::BruteForce);
     const Segment seg{at(a.x, a.y, a.z), at(b.x, b.y, b.z)};
@@ -151,11 +155,18 @@ TEST(SweptVolume, AnySegmentLiesBetweenDensePlacementsOfTheTool) {
 }
 
 TEST(SweptVolume, AnyBeadSegmentLiesBetweenDensePlacementsOfTheBead) {
-  const Bead bead{config::BeadShape::Ellipsoid, 2.2, 1.3, {}, {}};
-  for (const auto& [a, b] : general_segments()) {
+  // 2.3 wide: its flat sides below the widest line are 1.15 from the axis, no lattice row's
+  // distance from a segment along X at y = 3.1 (see below).
+  const Bead bead{config::BeadShape::Ellipsoid, 2.3, 1.3, {}, {}};
+  // Off the lattice's layers too: the bead's flat underside on a layer of voxel centres
+  // would put that whole layer on the boundary (as for a row at exactly the radius).
+  for (auto [a, b] : general_segments()) {
+    a.z += 0.013, b.z += 0.013;
+    SCOPED_TRACE("from (" + std::to_string(a.x) + "," + std::to_string(a.y) + "," + std::to_string(a.z) + ") to (" +
+                 std::to_string(b.x) + "," + std::to_string(b.y) + "," + std::to_string(b.z) + ")");
     const Solid got = swept_volume(pieces_of(bead), {a, b}, kLattice, kDomain);
     expect_between_dense_placements(
-        "ellipsoid bead", [&](double delta) { return ellipsoid_bead_shape(bead.width, bead.height, delta); }, 1.1, 0,
+        "ellipsoid bead", [&](double delta) { return ellipsoid_bead_shape(bead.width, bead.height, delta); }, 1.15, 0,
         1.3, got, a, b);
   }
 }
