@@ -60,6 +60,37 @@ TEST_F(Export, EveryProgramForTheExamplePartsPassesRs274AndOurCheck) {
   }
 }
 
+// The hybrid plan a shop would run by hand for the flanged hub: turned over, deposit the
+// hub with the flange on the plate, then mill it to size from the same side. It passes
+// validation by execution, and its program deposits (the head's output, M64/M65 P0) and
+// mills (the spindle, M3), which LinuxCNC's rs274 accepts.
+TEST_F(Export, TheFlangedHubDepositedThenMilledIsAValidatedPlanThatExports) {
+  const std::string machine = (kSource / "examples/machines/hybrid-3axis.yaml").string();
+  const fs::path plan = dir_ / "plan";
+  const Outcome planned = hybridctl({"plan", (kSource / "examples/parts/flanged-hub.stl").string(), "--machine", machine,
+                                     "--voxel", "0.5", "--top", "10", "-o", plan.string()});
+  ASSERT_EQ(planned.exit_code, 0) << planned.out << planned.err;
+  const std::size_t at = planned.out.find(". (P6 \u2212 P9)  cost");
+  ASSERT_NE(at, std::string::npos) << planned.out;
+  const std::size_t line = planned.out.rfind('\n', at) + 1;
+  const std::string rank = planned.out.substr(line, at - line);
+  EXPECT_NE(planned.out.find("P6   O-AM ded from -Z (bottom)"), std::string::npos) << planned.out;
+  EXPECT_NE(planned.out.find("P9   SM-max T1 (10 mm flat rougher) from -Z (bottom)"), std::string::npos) << planned.out;
+
+  const fs::path out = dir_ / "out";
+  const Outcome exported = hybridctl({"export", plan.string(), "--plan", rank.substr(rank.find_first_not_of(' ')), "-o", out.string()});
+  ASSERT_EQ(exported.exit_code, 0) << exported.out << exported.err;
+  EXPECT_NE(exported.out.find("(tolerance 0.50 mm, within)"), std::string::npos) << exported.out;
+  const std::string name = "plan-" + rank.substr(rank.find_first_not_of(' ')) + ".ngc";
+  const std::string program = slurp(out / name);
+  EXPECT_NE(program.find("M64 P0"), std::string::npos);
+  EXPECT_NE(program.find("M65 P0"), std::string::npos);
+  EXPECT_NE(program.find("S8000 M3"), std::string::npos) << "T1 at its spindle speed";
+  const Outcome linuxcnc = sh(quote((kSource / "scripts/rs274").string()) + " -t " + quote((out / "tool.tbl").string()) + " -g " +
+                              quote((out / name).string()));
+  EXPECT_EQ(linuxcnc.exit_code, 0) << linuxcnc.err.substr(0, 2000);
+}
+
 // A plan planned for a machine whose X travel is too short for the part where its setup
 // holds it: export posts the program, finds the first move beyond the travel and writes
 // nothing (exit 3, the action, the line and the axis). The bracket, which export refused
