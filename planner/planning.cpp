@@ -195,9 +195,9 @@ std::function<bool(const Plan&)> accept_hook(const PlanningOptions& options, Pla
   };
 }
 
-// Why no plan exists when every state the primitives reach keeps an atom wrong: the
-// nearest such state, and its largest wrong atoms with where they are and what holds them.
-std::string unreachable_text(const PlanningResult& r, const Reachability& reach) {
+// What the nearest state the exploration reached lacks and holds beyond the design: its
+// largest wrong atoms with where they are and what holds them.
+std::string nearest_text(const PlanningResult& r, const Reachability& reach) {
   struct Wrong {
     int atom;
     double volume;
@@ -221,17 +221,19 @@ std::string unreachable_text(const PlanningResult& r, const Reachability& reach)
       if (r.problem.primitives[i].atoms.test(big->atom)) in += (in.empty() ? "" : ", ") + r.problem.primitives[i].name;
     return std::string(where) + (in.empty() ? ", in no primitive" : ", in " + in);
   };
-  char head[160];
-  std::snprintf(head, sizeof head, "no sequence of these primitives makes the design: none of the %lld states they reach "
-                "(costs aside, each primitive any number of times) is within tolerance",
-                static_cast<long long>(reach.states));
-  std::string s = head;
-  s += ". The nearest lacks " + trimmed_number(missing_volume, 1) + " mm\u00B3 of design in " + std::to_string(missing.size()) +
-       " atoms";
+  std::string s = "lacks " + trimmed_number(missing_volume, 1) + " mm\u00B3 of design in " + std::to_string(missing.size()) +
+                  " atoms";
   if (!missing.empty()) s += " (largest: " + largest(missing) + ")";
   s += " and holds " + trimmed_number(extra_volume, 1) + " mm\u00B3 outside it in " + std::to_string(extra.size()) + " atoms";
   if (!extra.empty()) s += " (largest: " + largest(extra) + ")";
-  return s + ". Deposits cannot reach under material already there, and removals cannot spare design they pass through";
+  return s;
+}
+
+std::string unreachable_text(const PlanningResult& r, const Reachability& reach) {
+  return "no sequence of these primitives makes the design: none of the " + std::to_string(reach.states) +
+         " states they reach (costs aside, each primitive any number of times) is within tolerance. The nearest " +
+         nearest_text(r, reach) +
+         ". Deposits cannot reach under material already there, and removals cannot spare design they pass through";
 }
 
 void search_plans(int top_k, const PlanningOptions& options, const Progress& progress, PlanningResult& r,
@@ -246,6 +248,7 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
   search.max_rejected = options.max_rejected;
   r.validated = bool(options.validate);
   r.plans = find_plans(r.problem, search, &r.search);
+  std::string undecided_hint;
   if (r.plans.empty() && r.search.limit_reached && !r.verdict.decided_without_search) {
     // The search stopped without a plan: maybe none exists. Exploring what the primitives
     // reach at all, costs aside, can prove it.
@@ -258,6 +261,10 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
       progress("search", 1);
       return;
     }
+    if (!reach.goal)
+      undecided_hint = "; of the " + std::to_string(reach.states) +
+                       " states explored (costs aside, the exploration's limit), none is within tolerance, and the "
+                       "nearest " + nearest_text(r, reach);
   }
   progress("search", 1);
   if (r.plans.empty() && !r.verdict.decided_without_search) {
@@ -268,7 +275,7 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
                         : r.search.limit_reached
                             ? "undecided: no plan found within the search limits (" + std::to_string(r.search.expanded) +
                                   " states expanded, weighted A* included); no atom rules the part out, but the "
-                                  "primitives may not combine into it"
+                                  "primitives may not combine into it" + undecided_hint
                             : "no sequence of these primitives makes the design";
   }
 }
