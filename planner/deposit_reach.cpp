@@ -158,6 +158,48 @@ std::vector<AtomSet> atoms_in_nozzle_reach(const AtomDecomposition& atoms, geome
   return reach;
 }
 
+DepositFooting deposit_footing(const AtomDecomposition& atoms, const geometry::Solid& region,
+                               geometry::AxisDirection approach, int reach) {
+  const int n = atoms.atom_count();
+  DepositFooting out;
+  out.kind.assign(std::size_t(n), DepositFooting::None);
+  out.carriers.resize(std::size_t(n));
+  const geometry::IndexBox& d = atoms.domain();
+  const geometry::IndexBox bb = geometry::box_intersection(region.bounding_box(), d);
+  if (bb.empty()) return out;
+  const ColumnFrame f(d, approach);
+  const int lo[3] = {bb.lo.x, bb.lo.y, bb.lo.z}, hi[3] = {bb.hi.x, bb.hi.y, bb.hi.z};
+  // The first layer's position t along the column frame (0: the domain's lowest layer).
+  const int first = f.sign > 0 ? lo[f.axis] - f.lo[f.axis] : f.hi[f.axis] - hi[f.axis];
+  const int nu = f.nu(), nv = f.nv();
+  for (int v = lo[f.va] - f.lo[f.va]; v < hi[f.va] - f.lo[f.va]; ++v)
+    for (int u = lo[f.ua] - f.lo[f.ua]; u < hi[f.ua] - f.lo[f.ua]; ++u) {
+      int c[3];
+      c[f.ua] = f.lo[f.ua] + u, c[f.va] = f.lo[f.va] + v;
+      c[f.axis] = f.sign > 0 ? f.lo[f.axis] + first : f.hi[f.axis] - 1 - first;
+      if (!region.contains({c[0], c[1], c[2]})) continue;
+      const int b = f.atom(atoms, u, v, first);
+      if (first == 0) {
+        out.kind[std::size_t(b)] = DepositFooting::OnPlate;
+        continue;
+      }
+      if (out.kind[std::size_t(b)] == DepositFooting::OnPlate) continue;
+      if (out.kind[std::size_t(b)] == DepositFooting::None) {
+        out.kind[std::size_t(b)] = DepositFooting::NeedsCarrier;
+        out.carriers[std::size_t(b)] = AtomSet(n);
+      }
+      AtomSet& carriers = out.carriers[std::size_t(b)];
+      for (int t = std::max(0, first - 2); t <= first; ++t)
+        for (int dv = -reach; dv <= reach; ++dv)
+          for (int du = -reach; du <= reach; ++du) {
+            if (u + du < 0 || u + du >= nu || v + dv < 0 || v + dv >= nv) continue;
+            const int a = f.atom(atoms, u + du, v + dv, t);
+            if (a != b) carriers.set(a);
+          }
+    }
+  return out;
+}
+
 int deposit_reach_gap(double layer_height, double voxel_size) {
   // A layer holds at most floor(layer / h) + 1 voxel centres: material that many voxels
   // up lies in a later layer.

@@ -12,6 +12,7 @@
 #include "geometry/morphology.hpp"
 #include "planner/atom_set.hpp"
 #include "planner/atoms.hpp"
+#include "planner/search.hpp"
 
 namespace hybridctl::planner {
 
@@ -35,6 +36,16 @@ struct NozzleReach {
 // the relation is left empty, as it ignores how far up the body ends.
 std::vector<AtomSet> atoms_in_nozzle_reach(const AtomDecomposition& atoms, geometry::AxisDirection approach,
                                            const NozzleReach& nozzle);
+
+// What may carry the first layer of `region` built along `approach` (its lowest voxel
+// layer along the build direction, which a build plate carries when the plan starts with
+// it): per atom holding a voxel of that layer, OnPlate when one of them lies on the
+// domain's lowest layer (where the simulated machine's plate is), else NeedsCarrier with
+// every atom within `reach` voxels across and up to two layers under (or in) that layer.
+// `reach` should cover a bead's half width, the head's cone and a voxel of slack: an atom
+// of the first layer with none of those present has nothing under or beside it at all.
+DepositFooting deposit_footing(const AtomDecomposition& atoms, const geometry::Solid& region,
+                               geometry::AxisDirection approach, int reach);
 
 // The gap for a head's layer height on a lattice of voxel size h: floor(layer / h) + 1.
 int deposit_reach_gap(double layer_height, double voxel_size);

@@ -143,6 +143,26 @@ std::shared_ptr<const std::vector<AtomSet>> reach_limits(const PlanningResult& r
   return slot;
 }
 
+// What must carry the first layer of a head's primitive when the plan does not start with
+// it (deposit_reach.hpp). Only must-in atoms are held to it: a free atom's first layer with
+// nothing under it is left out by the toolpath, and the part may still be within
+// tolerance; a must-in atom's cannot be, and everything built on it goes with it.
+std::shared_ptr<const DepositFooting> first_layer_carriers(const PlanningResult& r, const config::Machine& machine,
+                                                           const Primitive& prim, const std::vector<AtomSpec>& atoms) {
+  if (prim.kind != PrimitiveKind::UAm && prim.kind != PrimitiveKind::OAm) return nullptr;
+  const auto head = std::find_if(machine.heads.begin(), machine.heads.end(),
+                                 [&](const config::AdditiveHead& h) { return h.name == prim.capability; });
+  const auto setup = std::find_if(machine.setups.begin(), machine.setups.end(),
+                                  [&](const config::Setup& s) { return s.name == prim.setup; });
+  if (head == machine.heads.end() || setup == machine.setups.end()) return nullptr;
+  // A bead's width, the cone over two layers and a voxel of slack, generously.
+  const int reach = int(std::ceil(head->bead.width / r.lattice.voxel_size)) + 2;
+  DepositFooting footing = deposit_footing(r.atoms, prim.region, instruments::approach_direction(setup->approach), reach);
+  for (std::size_t a = 0; a < atoms.size(); ++a)
+    if (!atoms[a].must_in && footing.kind[a] == DepositFooting::NeedsCarrier) footing.kind[a] = DepositFooting::None;
+  return std::make_shared<const DepositFooting>(std::move(footing));
+}
+
 PlanningProblem symbolic_problem(const PlanningResult& r, const config::Machine& machine, int max_uses) {
   const config::Planning& defaults = machine.planning;
   std::map<std::pair<int, int>, std::shared_ptr<const std::vector<AtomSet>>> reach_cache;
@@ -167,6 +187,7 @@ PlanningProblem symbolic_problem(const PlanningResult& r, const config::Machine&
     s.tool = prim.capability;
     s.setup = prim.setup;
     s.blocked_by = reach_limits(r, machine, prim, reach_cache);
+    s.footing = first_layer_carriers(r, machine, prim, p.atoms);
     s.atoms = AtomSet(r.atoms.atom_count());
     for (int a = 0; a < r.atoms.atom_count(); ++a)
       if (r.atoms.code(a).test(int(i))) s.atoms.set(a);

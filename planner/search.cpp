@@ -39,6 +39,23 @@ bool blocked(const std::vector<AtomSet>& blocked_by, const AtomSet& state, const
   return false;
 }
 
+// Whether an atom of the first layer in `deposited` has nothing to carry it: no plate (the
+// state holds material, so the plan did not start here) and no carrier present.
+bool floating(const DepositFooting& footing, const AtomSet& state, const std::vector<std::uint64_t>& deposited) {
+  const auto& s = state.words();
+  if (std::all_of(s.begin(), s.end(), [](std::uint64_t w) { return w == 0; })) return false;
+  for (std::size_t w = 0; w < deposited.size(); ++w)
+    for (std::uint64_t b = deposited[w]; b; b &= b - 1) {
+      const std::size_t atom = w * 64 + std::size_t(std::countr_zero(b));
+      if (footing.kind[atom] != DepositFooting::NeedsCarrier) continue;
+      const auto& carriers = footing.carriers[atom].words();
+      bool carried = false;
+      for (std::size_t k = 0; k < carriers.size() && !carried; ++k) carried = (carriers[k] & s[k]) != 0;
+      if (!carried) return true;
+    }
+  return false;
+}
+
 // The state after applying primitive `i`, and the volume it really changes; false when
 // it changes nothing or cannot be taken in this state.
 bool apply(const PlanningProblem& p, const AtomSet& state, int i, AtomSet& next, double& volume) {
@@ -61,6 +78,7 @@ bool apply(const PlanningProblem& p, const AtomSet& state, int i, AtomSet& next,
   }
   if (!any) return false;
   if (prim.mode == Mode::Additive && prim.blocked_by && blocked(*prim.blocked_by, state, changed)) return false;
+  if (prim.mode == Mode::Additive && prim.footing && floating(*prim.footing, state, changed)) return false;
   volume = volume_of_bits(p, changed);
   return true;
 }

@@ -23,6 +23,15 @@ struct AtomSpec {
   bool must_out = false;  // both false: free either way
 };
 
+// What carries the first layer of an additive primitive, the one its build plate carries
+// when the plan starts with it. Later in a plan the plate is not there: material already
+// present must lie near under or beside that layer (planner/deposit_reach.hpp).
+struct DepositFooting {
+  enum Kind : std::uint8_t { None, OnPlate, NeedsCarrier };  // per atom
+  std::vector<Kind> kind;
+  std::vector<AtomSet> carriers;  // per NeedsCarrier atom: the atoms that may carry it
+};
+
 struct PrimitiveSpec {
   std::string name;
   Mode mode = Mode::Additive;
@@ -35,6 +44,9 @@ struct PrimitiveSpec {
   // reach (planner/deposit_reach.hpp). The action cannot be taken in a state that holds one
   // of them over an atom it would deposit. Null: nothing limits it.
   std::shared_ptr<const std::vector<AtomSet>> blocked_by;
+  // Additive only: in a state that holds material, an atom of the first layer it would
+  // deposit needs a carrier present; null: nothing limits it.
+  std::shared_ptr<const DepositFooting> footing;
 };
 
 struct FixedCosts {

@@ -93,6 +93,42 @@ TEST(AtomsInNozzleReach, AreTheAtomsTheBodyMeetsOverTheDeposit) {
   for (const AtomSet& s : atoms_in_nozzle_reach(near.atoms, kFromAbove, {10, 5, 20})) EXPECT_TRUE(s.words().empty());
 }
 
+// A block deposited over a raw stock: its first layer (z = 6) is carried by the stock
+// when the stock reaches up to it, and by nothing when a gap of 4 voxels lies between.
+// As the plan's first action the block would stand on the build plate; after the stock,
+// the plate is not there.
+VoxelProblem block_over_stock(double stock_top) {
+  const Solid stock = make_box(kUnit, {{0, 0, 0}, {20, 1, stock_top}}), block = make_box(kUnit, {{5, 0, 6}, {15, 1, 10}});
+  VoxelProblem vp = make_problem({{"stock", Mode::Additive, true, 0.0, stock}, {"block", Mode::Additive, false, 1.0, block}},
+                                 unite(stock, block), {{0, 0, 0}, {20, 1, 12}});
+  vp.problem.primitives[1].footing = std::make_shared<const DepositFooting>(deposit_footing(vp.atoms, block, kFromAbove, 2));
+  return vp;
+}
+
+TEST(DepositFooting, IsTheAtomsNearUnderTheFirstLayer) {
+  const VoxelProblem touching = block_over_stock(6), apart = block_over_stock(2);
+  for (const VoxelProblem* vp : {&touching, &apart}) {
+    const DepositFooting& f = *vp->problem.primitives[1].footing;
+    const int block = vp->atoms.atom_at({10, 0, 6}), stock = vp->atoms.atom_at({10, 0, 0});
+    ASSERT_EQ(f.kind[std::size_t(block)], DepositFooting::NeedsCarrier);
+    EXPECT_EQ(f.kind[std::size_t(stock)], DepositFooting::None) << "not in the block's first layer";
+    EXPECT_EQ(f.carriers[std::size_t(block)].test(stock), vp == &touching);
+  }
+  // A first layer on the domain's lowest layer stands on the machine's plate.
+  const DepositFooting on_plate = deposit_footing(touching.atoms, touching.primitives[0].region, kFromAbove, 2);
+  EXPECT_EQ(on_plate.kind[std::size_t(touching.atoms.atom_at({10, 0, 0}))], DepositFooting::OnPlate);
+}
+
+TEST(DepositFooting, ABlockWithNothingUnderItIsNotDepositedAfterTheStock) {
+  EXPECT_EQ(find_plans(block_over_stock(6).problem, {5}).size(), 1u) << "the stock carries the block";
+  const VoxelProblem apart = block_over_stock(2);
+  EXPECT_TRUE(find_plans(apart.problem, {5}).empty()) << "the block would be laid over air";
+  EXPECT_TRUE(enumerate_plans(apart.problem).empty());
+  VoxelProblem blind = apart;
+  blind.problem.primitives[1].footing.reset();
+  EXPECT_EQ(find_plans(blind.problem, {5}).size(), 1u);
+}
+
 TEST(DepositReach, BothFromAboveOnlyTheLowerPartFirst) {
   const VoxelProblem vp = column(kFromAbove, kFromAbove);
   const auto plans = find_plans(vp.problem, {5});
