@@ -128,7 +128,7 @@ Verdict check_manufacturability(const PlanningProblem& p, const std::vector<Atom
     v.manufacturable = false;
     v.decided_without_search = true;
     v.summary = "not manufacturable within tolerance: " + std::to_string(v.violations.size()) +
-                " atom" + (v.violations.size() == 1 ? "" : "s") + " straddle the design";
+                (v.violations.size() == 1 ? " atom straddles the design" : " atoms straddle the design");
     return v;
   }
   switch (v.modality) {
