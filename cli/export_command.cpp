@@ -96,7 +96,7 @@ void add_export_command(CLI::App& app, Runner& runner) {
                                  "each action planned against the material the ones before it leave, the program "
                                  "executed on the simulated machine from the raw stock first (exit 4 and nothing "
                                  "written on a skipped layer, an unreachable region, a rapid or body into material, a "
-                                 "gouge or a refused line)");
+                                 "gouge, a refused line, a bead over air or a part out of tolerance)");
   cmd->add_option("PLAN", request->plan, "plan.json (or its directory) written by `hybridctl plan -o`")->required();
   cmd->add_option("-o,--output", request->output, "Directory for the programs (created if missing)")->required();
   cmd->add_option("--plan", request->rank, "Which plan, by rank (1 = cheapest)")->default_val(1)->check(greater_than(0));

@@ -193,9 +193,10 @@ int run_job(const RunRequest& request, std::vector<std::pair<std::string, std::u
 void add_run_command(CLI::App& app, Runner& runner) {
   auto request = std::make_shared<RunRequest>();
   auto* cmd = app.add_subcommand(
-      "run", "Stream a plan (plan.json: exported now) or a G-code program to a machine over Modbus or CAN, exactly once, "
-             "with a live status line; a job journal lets --resume continue after the host died (exit 5 when the "
-             "machine stopped before the end)");
+      "run", "Stream a plan (plan.json: exported now, and executed on the simulated machine first: exit 4 and "
+             "nothing streamed when it does not make its part or is unsafe) or a G-code program to a machine over "
+             "Modbus or CAN, exactly once, with a live status line; a job journal lets --resume continue after the "
+             "host died (exit 5 when the machine stopped before the end)");
   cmd->add_option("INPUT", request->input, "plan.json (or its directory) or a G-code program");
   cmd->add_option("-m,--machine", request->machine,
                   "Machine description (YAML); with a plan: the one plan.json embeds, and another machine is refused "

@@ -106,23 +106,24 @@ void decompose_into_atoms(const Progress& progress, PlanningResult& r) {
   r.measures = measure_atoms(r.atoms, r.design, make_tolerance_zone(r.design, r.tolerance), r.sliver_threshold);
 }
 
-// The symbolic problem the search runs on: atoms with volumes and classes, primitives as
-// sets of atoms.
+// The head of a machine's U-AM or O-AM primitive; null for any other primitive.
+const config::AdditiveHead* deposition_head(const config::Machine& machine, const Primitive& prim) {
+  if (prim.kind != PrimitiveKind::UAm && prim.kind != PrimitiveKind::OAm) return nullptr;
+  return machine.find_head(prim.capability);
+}
+
 // Per head and setup, which present atoms keep the head from an atom: over it in its
 // column, or in the nozzle's way (deposit_reach.hpp); setups that share an approach share
 // the relation.
 std::shared_ptr<const std::vector<AtomSet>> reach_limits(const PlanningResult& r, const config::Machine& machine,
                                                          const Primitive& prim,
                                                          std::map<std::pair<int, int>, std::shared_ptr<const std::vector<AtomSet>>>& cache) {
-  if (prim.kind != PrimitiveKind::UAm && prim.kind != PrimitiveKind::OAm) return nullptr;
-  const auto head = std::find_if(machine.heads.begin(), machine.heads.end(),
-                                 [&](const config::AdditiveHead& h) { return h.name == prim.capability; });
-  const auto setup = std::find_if(machine.setups.begin(), machine.setups.end(),
-                                  [&](const config::Setup& s) { return s.name == prim.setup; });
-  if (head == machine.heads.end() || setup == machine.setups.end()) return nullptr;
+  const config::AdditiveHead* head = deposition_head(machine, prim);
+  const config::Setup* setup = head ? machine.find_setup(prim.setup) : nullptr;
+  if (!setup) return nullptr;
   const geometry::AxisDirection approach = instruments::approach_direction(setup->approach);
   const int gap = deposit_reach_gap(head->layer_height, r.lattice.voxel_size);
-  auto& slot = cache[{int(approach.axis) * 2 + (approach.sign > 0), gap * 1000 + int(head - machine.heads.begin())}];
+  auto& slot = cache[{int(approach.axis) * 2 + (approach.sign > 0), gap * 1000 + int(head - machine.heads.data())}];
   if (slot) return slot;
   std::vector<AtomSet> blocked = atoms_above(r.atoms, approach, gap);
   if (head->nozzle) {
@@ -149,12 +150,9 @@ std::shared_ptr<const std::vector<AtomSet>> reach_limits(const PlanningResult& r
 // tolerance; a must-in atom's cannot be, and everything built on it goes with it.
 std::shared_ptr<const DepositFooting> first_layer_carriers(const PlanningResult& r, const config::Machine& machine,
                                                            const Primitive& prim, const std::vector<AtomSpec>& atoms) {
-  if (prim.kind != PrimitiveKind::UAm && prim.kind != PrimitiveKind::OAm) return nullptr;
-  const auto head = std::find_if(machine.heads.begin(), machine.heads.end(),
-                                 [&](const config::AdditiveHead& h) { return h.name == prim.capability; });
-  const auto setup = std::find_if(machine.setups.begin(), machine.setups.end(),
-                                  [&](const config::Setup& s) { return s.name == prim.setup; });
-  if (head == machine.heads.end() || setup == machine.setups.end()) return nullptr;
+  const config::AdditiveHead* head = deposition_head(machine, prim);
+  const config::Setup* setup = head ? machine.find_setup(prim.setup) : nullptr;
+  if (!setup) return nullptr;
   // A bead's width, the cone over two layers and a voxel of slack, generously.
   const int reach = int(std::ceil(head->bead.width / r.lattice.voxel_size)) + 2;
   DepositFooting footing = deposit_footing(r.atoms, prim.region, instruments::approach_direction(setup->approach), reach);
@@ -163,6 +161,8 @@ std::shared_ptr<const DepositFooting> first_layer_carriers(const PlanningResult&
   return std::make_shared<const DepositFooting>(std::move(footing));
 }
 
+// The symbolic problem the search runs on: atoms with volumes and classes, primitives as
+// sets of atoms, deposits with what the plan's state may rule out.
 PlanningProblem symbolic_problem(const PlanningResult& r, const config::Machine& machine, int max_uses) {
   const config::Planning& defaults = machine.planning;
   std::map<std::pair<int, int>, std::shared_ptr<const std::vector<AtomSet>>> reach_cache;
