@@ -88,8 +88,12 @@ int run_plan(const PlanArgs& args) {
   }
   std::printf(" total %.2f s\n", total);
   if (args.report) {  // also, and most of all, for a part that is not manufacturable
+    // The plan in memory is the plan on disk (PlanInMemory tests): its solids need not be
+    // read back.
+    const planner::PlanFile in_memory = planner::to_plan_file(result, sources, plan_dir);
     report::ReportRequest request;
     request.plan = plan_dir;
+    request.in_memory = &in_memory;
     write_job_report(request);
   }
   if (!args.export_dir.empty() && result.verdict.manufacturable && !result.plans.empty()) {

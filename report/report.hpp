@@ -10,6 +10,10 @@
 #include <string>
 #include <vector>
 
+namespace hybridctl::planner {
+struct PlanFile;
+}
+
 namespace hybridctl::report {
 
 // Debian's libjs-three (r111): its UMD build and the orbit controls of its examples.
@@ -32,6 +36,9 @@ inline constexpr std::size_t kDefaultSizeBudget = 20u << 20;
 
 struct ReportRequest {
   std::filesystem::path plan;        // plan.json or its directory
+  // The plan as `plan` holds it (`plan --report`), equal to what PLAN_DIR reads back as
+  // (planner::to_plan_file): its solids are not read back from the .vdb files. Null: read.
+  const planner::PlanFile* in_memory = nullptr;
   std::filesystem::path output;      // the page; empty: PLAN_DIR/report.html
   std::filesystem::path as_built;    // optional: `sim serve --as-built` of a run of plan 1
   std::filesystem::path run_report;  // optional: `sim serve --report` of that run

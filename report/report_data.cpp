@@ -77,7 +77,8 @@ class Gatherer {
  public:
   Gatherer(const ReportRequest& request, ReportData& data)
       : request_(request), data_(data), raw_(read_json(plan_json_path(request.plan), "a plan.json (hybridctl plan -o DIR)")),
-        file_(planner::read_plan_file(request.plan)), machine_(planner::plan_machine(file_, {}).machine) {}
+        owned_(request.in_memory ? planner::PlanFile{} : planner::read_plan_file(request.plan)),
+        file_(request.in_memory ? *request.in_memory : owned_), machine_(planner::plan_machine(file_, {}).machine) {}
 
   void run() {
     json& doc = data_.document;
@@ -266,7 +267,8 @@ class Gatherer {
   const ReportRequest& request_;
   ReportData& data_;
   json raw_;
-  planner::PlanFile file_;
+  planner::PlanFile owned_;  // read from the directory when the request holds none
+  const planner::PlanFile& file_;
   config::Machine machine_;
   std::vector<geometry::Vec3> line_positions_;
   struct MeshJob {

@@ -16,6 +16,7 @@
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
 #include "geometry/mesh.hpp"
+#include "planner/plan_file.hpp"
 #include "planner/plan_report.hpp"
 #include "geometry/vdb_file.hpp"
 #include "report/report.hpp"
@@ -138,6 +139,35 @@ TEST(Report, IsOneSelfContainedPageWithEveryPlanItsStatesAndToolpaths) {
   ASSERT_EQ(r.snapshots.size(), 1 + plan["plans"].size());  // the overview, a strip per plan
   EXPECT_EQ(r.snapshots[1], dir / "report-plan-1.png");
   for (const fs::path& png : r.snapshots) EXPECT_GT(drawn_share(png), 0.05) << png << " shows almost nothing";
+}
+
+// `plan --report` hands the report the plan it holds in memory instead of reading the
+// solids back from the directory: the page is the same, byte for byte.
+TEST(Report, FromThePlanInMemoryIsTheReportFromItsDirectory) {
+  const std::string text = config::read_machine_text(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
+  const config::Machine machine = config::parse_machine(text, "hybrid-3axis.yaml");
+  planner::PlanningOptions options;
+  options.voxel_size = 2.0;
+  options.top_k = 2;
+  const auto part = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/flanged-hub.stl");
+  const planner::PlanningResult result = planner::plan_part(part, "flanged-hub.stl", machine, options);
+  ASSERT_FALSE(result.plans.empty());
+  const fs::path dir = test_root() / "in-memory";
+  const planner::ReportSources sources{"flanged-hub.stl", "hybrid-3axis.yaml", machine.name, text};
+  planner::write_plan_directory(result, sources, dir);
+  const planner::PlanFile in_memory = planner::to_plan_file(result, sources, dir);
+
+  ReportRequest request;
+  request.plan = dir;
+  request.snapshots = false;
+  request.output = dir / "from-directory.html";
+  const ReportResult read = write_report(request);
+  request.in_memory = &in_memory;
+  request.output = dir / "from-memory.html";
+  const ReportResult held = write_report(request);
+  EXPECT_EQ(held.plans, 2);
+  EXPECT_EQ(held.bytes, read.bytes);
+  EXPECT_TRUE(slurp(held.page) == slurp(read.page));
 }
 
 TEST(Report, ListsEachOffendingAtomOfAPartTheMachineCannotMake) {
