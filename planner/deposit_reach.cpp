@@ -7,47 +7,6 @@
 
 namespace hybridctl::planner {
 
-std::vector<AtomSet> atoms_above(const AtomDecomposition& atoms, geometry::AxisDirection approach, int gap) {
-  const int n = atoms.atom_count();
-  std::vector<AtomSet> above(static_cast<std::size_t>(n));
-  const geometry::IndexBox& d = atoms.domain();
-  if (d.empty()) return above;
-  // Lattice coordinates of (u, v) across the column and t along it, towards the head.
-  const geometry::Index3 lo = d.lo, hi = d.hi;
-  const int axis = approach.axis == geometry::Axis::X ? 0 : approach.axis == geometry::Axis::Y ? 1 : 2;
-  const int lo3[3] = {lo.x, lo.y, lo.z}, hi3[3] = {hi.x, hi.y, hi.z};
-  const int ua = (axis + 1) % 3, va = (axis + 2) % 3;
-  const int len = hi3[axis] - lo3[axis];
-  struct Run {
-    int atom, first, last;  // positions along the column, from the far side
-  };
-  std::vector<Run> runs;
-  for (int v = lo3[va]; v < hi3[va]; ++v)
-    for (int u = lo3[ua]; u < hi3[ua]; ++u) {
-      runs.clear();
-      for (int t = 0; t < len; ++t) {
-        int c[3];
-        c[ua] = u, c[va] = v;
-        c[axis] = approach.sign > 0 ? lo3[axis] + t : hi3[axis] - 1 - t;
-        const int a = atoms.atom_at_unchecked(c[0] - lo.x, c[1], c[2]);
-        if (!runs.empty() && runs.back().atom == a)
-          runs.back().last = t;
-        else
-          runs.push_back({a, t, t});
-      }
-      // Run j lies above run i; some voxel of j is `gap` above some voxel of i when j's
-      // last reaches i's first plus the gap.
-      for (std::size_t i = 0; i < runs.size(); ++i)
-        for (std::size_t j = i + 1; j < runs.size(); ++j) {
-          if (runs[j].atom == runs[i].atom || runs[j].last < runs[i].first + gap) continue;
-          AtomSet& s = above[std::size_t(runs[i].atom)];
-          if (s.words().empty()) s = AtomSet(n);
-          s.set(runs[j].atom);
-        }
-    }
-  return above;
-}
-
 namespace {
 
 // A domain seen along a build axis: columns (u, v) across it, t along it towards the head.
@@ -73,6 +32,41 @@ struct ColumnFrame {
 };
 
 }  // namespace
+
+std::vector<AtomSet> atoms_above(const AtomDecomposition& atoms, geometry::AxisDirection approach, int gap) {
+  const int n = atoms.atom_count();
+  std::vector<AtomSet> above(static_cast<std::size_t>(n));
+  const geometry::IndexBox& d = atoms.domain();
+  if (d.empty()) return above;
+  const ColumnFrame f(d, approach);
+  const int len = f.length();
+  struct Run {
+    int atom, first, last;  // positions along the column, from the far side
+  };
+  std::vector<Run> runs;
+  for (int v = 0; v < f.nv(); ++v)
+    for (int u = 0; u < f.nu(); ++u) {
+      runs.clear();
+      for (int t = 0; t < len; ++t) {
+        const int a = f.atom(atoms, u, v, t);
+        if (!runs.empty() && runs.back().atom == a)
+          runs.back().last = t;
+        else
+          runs.push_back({a, t, t});
+      }
+      // Run j lies above run i; some voxel of j is `gap` above some voxel of i when j's
+      // last reaches i's first plus the gap.
+      for (std::size_t i = 0; i < runs.size(); ++i)
+        for (std::size_t j = i + 1; j < runs.size(); ++j) {
+          if (runs[j].atom == runs[i].atom || runs[j].last < runs[i].first + gap) continue;
+          AtomSet& s = above[std::size_t(runs[i].atom)];
+          if (s.words().empty()) s = AtomSet(n);
+          s.set(runs[j].atom);
+        }
+    }
+  return above;
+}
+
 
 std::vector<AtomSet> atoms_in_nozzle_reach(const AtomDecomposition& atoms, geometry::AxisDirection approach,
                                            const NozzleReach& nozzle) {
