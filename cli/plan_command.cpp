@@ -87,21 +87,23 @@ int run_plan(const PlanArgs& args) {
     total += seconds;
   }
   std::printf(" total %.2f s\n", total);
+  const bool exports = !args.export_dir.empty() && result.verdict.manufacturable && !result.plans.empty();
+  // The plan in memory is the plan on disk (PlanInMemory tests): report and export need not
+  // read its solids back.
+  const planner::PlanFile in_memory =
+      args.report || exports ? planner::to_plan_file(result, sources, plan_dir) : planner::PlanFile{};
   if (args.report) {  // also, and most of all, for a part that is not manufacturable
-    // The plan in memory is the plan on disk (PlanInMemory tests): its solids need not be
-    // read back.
-    const planner::PlanFile in_memory = planner::to_plan_file(result, sources, plan_dir);
     report::ReportRequest request;
     request.plan = plan_dir;
     request.in_memory = &in_memory;
     write_job_report(request);
   }
-  if (!args.export_dir.empty() && result.verdict.manufacturable && !result.plans.empty()) {
+  if (exports) {
     ExportRequest request;
     request.plan = plan_dir;
     request.output = args.export_dir;
     request.dialect = args.dialect;
-    const int code = export_plan_programs(planner::to_plan_file(result, sources, plan_dir), request);
+    const int code = export_plan_programs(in_memory, request);
     if (code != kSuccess) return code;
   }
   return result.verdict.manufacturable && !result.plans.empty() ? int(kSuccess) : int(kNotManufacturable);
