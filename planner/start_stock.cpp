@@ -7,19 +7,12 @@
 
 namespace hybridctl::planner {
 
-geometry::Solid start_stock(const PlanFile& file, const PlanFilePlan& plan, const config::Machine& machine) {
-  if (plan.actions.empty()) return geometry::Solid(file.lattice, file.domain);
-  const PlanFilePrimitive& first = file.primitives.at(std::size_t(plan.actions.front().primitive));
-  if (first.raw_stock()) {
-    geometry::Solid stock(file.lattice, file.domain);
-    first.region.for_each_voxel([&](geometry::Index3 v) {
-      if (file.domain.contains(v)) stock.set(v);
-    });
-    return stock;
-  }
+geometry::IndexBox simulated_domain(const PlanFile& file, const PlanFilePlan& plan, const config::Machine& machine) {
   geometry::IndexBox box = file.domain;
+  if (plan.actions.empty()) return box;
+  const PlanFilePrimitive& first = file.primitives.at(std::size_t(plan.actions.front().primitive));
   const geometry::IndexBox region = first.region.bounding_box();
-  if (first.mode != Mode::Additive || region.empty() || first.setup.empty()) return geometry::Solid(file.lattice, box);
+  if (first.raw_stock() || first.mode != Mode::Additive || region.empty() || first.setup.empty()) return box;
   const auto setup = std::find_if(machine.setups.begin(), machine.setups.end(),
                                   [&](const config::Setup& s) { return s.name == first.setup; });
   if (setup == machine.setups.end())
@@ -34,7 +27,19 @@ geometry::Solid start_stock(const PlanFile& file, const PlanFilePlan& plan, cons
     case config::Approach::PlusY: box.lo.y = std::max(box.lo.y, region.lo.y); break;
     case config::Approach::MinusY: box.hi.y = std::min(box.hi.y, region.hi.y); break;
   }
-  return geometry::Solid(file.lattice, box);
+  return box;
+}
+
+geometry::Solid start_stock(const PlanFile& file, const PlanFilePlan& plan, const config::Machine& machine) {
+  geometry::Solid stock(file.lattice, simulated_domain(file, plan, machine));
+  if (!plan.actions.empty()) {
+    const PlanFilePrimitive& first = file.primitives.at(std::size_t(plan.actions.front().primitive));
+    if (first.raw_stock())
+      first.region.for_each_voxel([&](geometry::Index3 v) {
+        if (file.domain.contains(v)) stock.set(v);
+      });
+  }
+  return stock;
 }
 
 geometry::Solid spared_by_cuts(const PlanFile& file, const PlanFilePrimitive* action) {

@@ -18,6 +18,11 @@ namespace hybridctl::planner {
 // (docs/toolpaths.md, build_plate_z). Throws InputError when that setup is not the machine's.
 geometry::Solid start_stock(const PlanFile& file, const PlanFilePlan& plan, const config::Machine& machine);
 
+// The box the simulated machine works in for `plan` (start_stock's storage box): its
+// lowest voxel layer in a setup's work frame stands on the build plate there, so plan
+// export lays a later deposit's first layer on the same plate. Throws as start_stock.
+geometry::IndexBox simulated_domain(const PlanFile& file, const PlanFilePlan& plan, const config::Machine& machine);
+
 // What the cuts of an action must spare: the design the action keeps, shrunk by the
 // tolerance. A removal's own region is not spared: SM-cons keeps only the tool's body clear
 // of the design, so its region takes design material on purpose, for a later deposit to

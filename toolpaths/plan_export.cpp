@@ -4,6 +4,8 @@
 
 #include "common/error.hpp"
 #include "instruments/bead.hpp"
+#include "planner/start_stock.hpp"
+#include "toolpaths/setup_frame.hpp"
 
 namespace hybridctl::toolpaths {
 namespace {
@@ -15,9 +17,17 @@ const config::Setup& setup_named(const config::Machine& m, const planner::PlanFi
                    "'; expected one of its setups");
 }
 
+// Where the simulated machine has its build plate in `setup`'s work frame: under the
+// lowest voxel layer of the box it works in (planner::simulated_domain; for a plan that
+// starts by depositing, that box starts at the first deposit's lowest layer in its setup).
+// A deposit onto nothing has the plate under its own first layer (the toolpath's default).
+double plate_z(const planner::PlanFile& file, const geometry::IndexBox& simulated, const config::Setup& setup) {
+  return file.lattice.origin.z + part_to_work(simulated, file.lattice, setup.approach).lo.z * file.lattice.voxel_size;
+}
+
 // The action's toolpath from its region of influence in the material it meets.
-void make_program(const planner::PlanFilePrimitive& p, const config::Machine& machine, const ExportOptions& options,
-                  ExportedAction& a) {
+void make_program(const planner::PlanFile& file, const geometry::IndexBox& simulated, const planner::PlanFilePrimitive& p,
+                  const config::Machine& machine, const ExportOptions& options, ExportedAction& a) {
   const config::Setup& setup = setup_named(machine, p);
   ActionProgram& prog = a.program;
   prog.action = a.step;
@@ -38,6 +48,7 @@ void make_program(const planner::PlanFilePrimitive& p, const config::Machine& ma
     if (!head) throw InputError(p.name + " (" + p.label + "): the machine has no head '" + p.capability + "'");
     DepositionOptions d = options.deposition;
     d.fallback_tool_number = instruments::head_tool_number(machine, index);
+    if (!d.build_plate_z && !a.before.empty()) d.build_plate_z = plate_z(file, simulated, setup);
     prog.path = deposition_path(a.roi, a.before, *head, setup, d);
   } else {
     const config::CuttingTool* tool = machine.find_tool(p.tool_number);
@@ -84,6 +95,7 @@ void export_from(int first, geometry::Solid present, const std::vector<geometry:
                  const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
                  const ExportOptions& options, const MaterialAfter& material_after, PlanExport& out) {
   const int n = int(plan.actions.size());
+  const geometry::IndexBox simulated = planner::simulated_domain(file, plan, machine);
   for (int k = first; k < n; ++k) {
     if (options.progress) options.progress(k + 1, n);
     const planner::PlanFilePrimitive& p = file.primitives[std::size_t(plan.actions[std::size_t(k)].primitive)];
@@ -104,7 +116,7 @@ void export_from(int first, geometry::Solid present, const std::vector<geometry:
       throw InputError(p.name + " is a primitive from the file " + p.capability +
                        ": no head or tool of the machine is known to make it; expected machine primitives only");
     } else {
-      make_program(p, machine, options, a);
+      make_program(file, simulated, p, machine, options, a);
     }
     if (material_after) present = material_after(a);
     out.actions.push_back(std::move(a));

@@ -152,6 +152,42 @@ TEST(Execution, DepositOverAirIsNotLaidAndThePartLacksIt) {
   EXPECT_FALSE(run.proven());
 }
 
+// The build plate is where the simulated machine has it: a stock clamped above the
+// domain's floor has no plate under its lowest layer, so a block deposited beside it from
+// that layer is over air except where the stock's side carries the beads. The toolpath
+// does not lay it (it used to take the lowest material present for the plate, lay the
+// block, and the simulator let it fall).
+TEST(Execution, ADepositBesideAStockAboveTheFloorHasNoPlateUnderIt) {
+  Case c(0.5);
+  const Solid raw = c.box({{0, 0, 4}, {20, 20, 10}}), block = c.box({{20, 0, 4}, {30, 20, 8}});
+  c.file.design = unite(raw, block);
+  const Execution run = execute_plan(c.file, c.plan({c.stock(raw), c.deposit(block)}), machine());
+  ASSERT_EQ(run.exported.actions.size(), 2u) << all_reasons(run);
+  bool not_deposited = false;
+  for (const std::string& w : run.exported.actions[1].program.path.warnings)
+    not_deposited = not_deposited || (w.find("overhang") != std::string::npos && w.find("not deposited") != std::string::npos);
+  EXPECT_TRUE(not_deposited) << all_reasons(run);
+  EXPECT_FALSE(has(run, "unsupported_deposit")) << all_reasons(run);
+  EXPECT_TRUE(has(run, "missing_material")) << all_reasons(run);
+}
+
+// A plan that starts by depositing has its plate under the first layer, and the plate
+// stays there, fixed to the part: after the part was turned over and milled from below,
+// a block deposited from above beside the first one, from the same layer, stands on it.
+TEST(Execution, ThePlateOfTheFirstDepositIsStillThereAfterAnotherSetup) {
+  Case c(0.5);
+  const Solid pad = c.box({{5, 5, 4}, {25, 25, 8}}), step = c.box({{15, 0, -5}, {30, 30, 5}});
+  const Solid block = c.box({{25, 5, 4}, {35, 25, 7}});
+  c.file.design = unite(subtract(pad, step), block);
+  const int d = c.deposit(pad), m = c.mill(step, 1, "bottom"), b = c.deposit(block);
+  const Execution run = execute_plan(c.file, c.plan({d, m, b}), machine());
+  ASSERT_EQ(run.exported.actions.size(), 3u) << all_reasons(run);
+  ASSERT_TRUE(run.exported.actions[1].makes_gcode) << "the mill turns the part over: " << all_reasons(run);
+  EXPECT_FALSE(has(run, "unsupported_deposit")) << all_reasons(run);
+  EXPECT_FALSE(has(run, "missing_material")) << all_reasons(run);
+  EXPECT_GT(run.report.deposited, 0.9 * (20 * 20 * 4 + 10 * 20 * 3)) << all_reasons(run);
+}
+
 // A deposit under a table-shaped stock: the head cannot reach it from above.
 TEST(Execution, ALayerUnderExistingMaterialIsSkippedAndRejected) {
   Case c(0.5);
