@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <fstream>
 
+#include <tbb/parallel_for.h>
+
 #include "common/atomic_file.hpp"
 #include "common/error.hpp"
 #include "report/report_data.hpp"
@@ -65,16 +67,23 @@ std::vector<fs::path> write_snapshots(const ReportData& data, const fs::path& pa
     for (const IndexedMesh& m : plan.states) grow(bounds, any, m);
   for (const IndexedMesh& m : data.violating) grow(bounds, any, m);
   if (!any) return {};
-  std::vector<fs::path> written;
-  SnapshotTile overview{{{&data.design, kDesign, false}}, {}};
-  for (const IndexedMesh& m : data.violating) overview.meshes.push_back({&m, kViolating, true});
-  written.push_back(beside(page, "-overview.png"));
-  write_png(render_tiles({overview}, bounds, 1, 960, 640), written.back());
-  for (std::size_t k = 0; k < data.plans.size(); ++k) {
-    if (data.plans[k].states.empty()) continue;
-    written.push_back(beside(page, "-plan-" + std::to_string(k + 1) + ".png"));
-    write_png(plan_strip(data.plans[k], bounds), written.back());
-  }
+  // The overview, then one strip per plan with states; rendered in parallel.
+  std::vector<fs::path> written{beside(page, "-overview.png")};
+  std::vector<std::size_t> strips;
+  for (std::size_t k = 0; k < data.plans.size(); ++k)
+    if (!data.plans[k].states.empty()) {
+      strips.push_back(k);
+      written.push_back(beside(page, "-plan-" + std::to_string(k + 1) + ".png"));
+    }
+  tbb::parallel_for(std::size_t(0), written.size(), [&](std::size_t i) {
+    if (i == 0) {
+      SnapshotTile overview{{{&data.design, kDesign, false}}, {}};
+      for (const IndexedMesh& m : data.violating) overview.meshes.push_back({&m, kViolating, true});
+      write_png(render_tiles({overview}, bounds, 1, 960, 640), written[0]);
+    } else {
+      write_png(plan_strip(data.plans[strips[i - 1]], bounds), written[i]);
+    }
+  });
   return written;
 }
 

@@ -207,23 +207,18 @@ class Gatherer {
     return entry;
   }
 
-  // What each plan needs that takes time, computed for all plans in parallel: its states
-  // and its toolpaths (or why it has none).
+  // What each plan needs that takes time: its states, then the toolpaths of all plans
+  // (each distinct action once) or why a plan has none.
   struct PlanWork {
     std::vector<geometry::Solid> states;
     PlanPaths paths;
-    std::string toolpath_error;
   };
   std::vector<PlanWork> plan_work() const {
+    std::vector<std::vector<geometry::Solid>> states(file_.plans.size());
+    tbb::parallel_for(std::size_t(0), states.size(), [&](std::size_t k) { states[k] = planner::plan_states(file_, file_.plans[k]); });
+    std::vector<PlanPaths> paths = plan_paths(file_, states, machine_);
     std::vector<PlanWork> work(file_.plans.size());
-    tbb::parallel_for(std::size_t(0), work.size(), [&](std::size_t k) {
-      work[k].states = planner::plan_states(file_, file_.plans[k]);
-      try {
-        work[k].paths = plan_paths(file_, file_.plans[k], machine_);
-      } catch (const std::exception& e) {  // the plan is still shown, without its toolpaths
-        work[k].toolpath_error = e.what();
-      }
-    });
+    for (std::size_t k = 0; k < work.size(); ++k) work[k] = {std::move(states[k]), std::move(paths[k])};
     return work;
   }
 
@@ -235,7 +230,7 @@ class Gatherer {
       const planner::PlanFilePlan& plan = file_.plans[k];
       json entry = k < listed.size() ? listed[k] : json::object();
       entry.erase("final_atoms");
-      if (!work[k].toolpath_error.empty()) entry["toolpath_error"] = work[k].toolpath_error;
+      if (!work[k].paths.error.empty()) entry["toolpath_error"] = work[k].paths.error;
       const json raw_actions = field(entry, "actions", json::array());
       const PlanPaths& paths = work[k].paths;
       if (k == 0) line_positions_ = paths.line_positions;

@@ -1,7 +1,14 @@
 #include "report/report_toolpaths.hpp"
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <map>
 #include <numbers>
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 #include "gcode/check.hpp"
 #include "gcode/post.hpp"
@@ -113,14 +120,10 @@ ActionPath action_path(const toolpaths::ExportedAction& exported, const config::
   return path;
 }
 
-}  // namespace
-
-PlanPaths plan_paths(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine) {
-  const toolpaths::PlanExport exported = toolpaths::export_plan(file, plan, machine);
-  PlanPaths paths;
-  for (const toolpaths::ExportedAction& action : exported.actions) paths.actions.push_back(action_path(action, machine));
-  const std::vector<gcode::ActionProgram> programs = exported.programs();
-  if (programs.empty()) return paths;
+// Where the tool is after each line of the plan's program.
+std::vector<Vec3> line_positions(const std::vector<gcode::ActionProgram>& programs, const config::Machine& machine) {
+  std::vector<Vec3> out;
+  if (programs.empty()) return out;
   const gcode::PostedProgram posted = gcode::post_program(programs, machine);
   Vec3 at = toolpaths::work_to_part(programs.front().path.start, approach_of(machine, programs.front().path.setup));
   for (const gcode::LineOrigin& origin : posted.origins) {
@@ -128,9 +131,74 @@ PlanPaths plan_paths(const planner::PlanFile& file, const planner::PlanFilePlan&
       const gcode::Toolpath& tp = programs[*origin.action].path;
       if (*origin.move < tp.moves.size()) at = toolpaths::work_to_part(tp.moves[*origin.move].to, approach_of(machine, tp.setup));
     }
-    paths.line_positions.push_back(at);
+    out.push_back(at);
   }
-  return paths;
+  return out;
+}
+
+// One distinct action: the first plan that has it, and its place there.
+struct ActionJob {
+  std::size_t plan = 0, action = 0;
+  double cost = 0;
+  ActionPath path;
+  gcode::ActionProgram program;  // when path.makes_gcode
+  std::string error;
+};
+
+}  // namespace
+
+std::vector<PlanPaths> plan_paths(const planner::PlanFile& file, const std::vector<std::vector<geometry::Solid>>& states,
+                                  const config::Machine& machine) {
+  std::vector<ActionJob> jobs;
+  std::map<std::vector<int>, std::size_t> job_of;           // by the primitives up to the action
+  std::vector<std::vector<std::size_t>> plan_jobs(file.plans.size());
+  for (std::size_t k = 0; k < file.plans.size(); ++k) {
+    std::vector<int> prefix;
+    for (std::size_t a = 0; a < file.plans[k].actions.size(); ++a) {
+      prefix.push_back(file.plans[k].actions[a].primitive);
+      const auto [it, fresh] = job_of.emplace(prefix, jobs.size());
+      if (fresh) jobs.push_back({k, a, file.plans[k].actions[a].cost, {}, {}, {}});
+      plan_jobs[k].push_back(it->second);
+    }
+  }
+  std::vector<std::size_t> order(jobs.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return jobs[a].cost > jobs[b].cost; });
+  // Each worker takes the next job in that order (a parallel_for would split the range
+  // and might leave the longest job to the end).
+  std::atomic<std::size_t> next{0};
+  tbb::task_group workers;
+  for (int w = 0; w < std::max(1, tbb::this_task_arena::max_concurrency()); ++w)
+    workers.run([&] {
+      for (std::size_t i = next++; i < order.size(); i = next++) {
+        ActionJob& job = jobs[order[i]];
+        try {
+          const toolpaths::ExportedAction exported = toolpaths::export_planned_action(
+              file, file.plans[job.plan], int(job.action), states.at(job.plan), machine);
+          job.path = action_path(exported, machine);
+          if (exported.makes_gcode) job.program = exported.program;
+        } catch (const std::exception& e) {  // the plan is still shown, without its toolpaths
+          job.error = e.what();
+        }
+      }
+    });
+  workers.wait();
+
+  std::vector<PlanPaths> out(file.plans.size());
+  tbb::parallel_for(std::size_t(0), out.size(), [&](std::size_t k) {
+    std::vector<gcode::ActionProgram> programs;
+    for (const std::size_t j : plan_jobs[k]) {
+      if (!jobs[j].error.empty() && out[k].error.empty()) out[k].error = jobs[j].error;
+      out[k].actions.push_back(jobs[j].path);  // the same step in every plan that has it
+      if (out[k].actions.back().makes_gcode) programs.push_back(jobs[j].program);
+    }
+    if (!out[k].error.empty()) {
+      out[k].actions.clear();
+      return;
+    }
+    out[k].line_positions = line_positions(programs, machine);
+  });
+  return out;
 }
 
 }  // namespace hybridctl::report

@@ -39,10 +39,17 @@ struct PlanPaths {
   // For each line of the plan's program (gcode::post_program, the program `run` and
   // `dry-run` stream), where the tool is after it, part frame: to place a run's alarms.
   std::vector<geometry::Vec3> line_positions;
+  // Why the plan has no toolpaths (what export throws for a plan the machine cannot
+  // make); empty when it has them.
+  std::string error;
 };
 
-// The plan's actions with their toolpaths (toolpaths::export_plan) and cycle times.
-// Throws what export_plan throws for a plan the machine cannot make.
-PlanPaths plan_paths(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine);
+// Every plan's actions with their toolpaths (as toolpaths::export_plan makes them against
+// the planned states) and cycle times; `states[k]` are plan k's (planner::plan_states).
+// An action depends only on the primitives up to it, so plans that begin alike share
+// their first actions: each distinct one is exported once. The exports run in parallel,
+// the costliest (by the plan's cost of the action) first, so that no long one starts last.
+std::vector<PlanPaths> plan_paths(const planner::PlanFile& file, const std::vector<std::vector<geometry::Solid>>& states,
+                                  const config::Machine& machine);
 
 }  // namespace hybridctl::report

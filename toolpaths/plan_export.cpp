@@ -89,6 +89,32 @@ void check_machine(const planner::PlanFile& file, const config::Machine& machine
                      "'; expected the machine file it was planned with (" + file.machine_file + ")");
 }
 
+// Action `k` of the plan, meeting `before`; `after` is the planned state after it, or
+// null when the material present is fed back (the action's primitive applied to `before`).
+ExportedAction make_action(int k, geometry::Solid before, const geometry::Solid* after, const geometry::IndexBox& simulated,
+                           const planner::PlanFile& file, const planner::PlanFilePlan& plan,
+                           const config::Machine& machine, const ExportOptions& options) {
+  const planner::PlanFilePrimitive& p = file.primitives.at(std::size_t(plan.actions.at(std::size_t(k)).primitive));
+  const bool additive = p.mode == planner::Mode::Additive;
+  ExportedAction a;
+  a.step = k + 1;
+  a.primitive = p.name;
+  a.before = std::move(before);
+  a.after = after ? *after : additive ? unite(a.before, p.region) : subtract(a.before, p.region);
+  a.roi = additive ? subtract(p.region, a.before) : intersect(a.before, p.region);
+  if (p.raw_stock()) {
+    a.note = "clamp the raw stock: " + p.label;
+  } else if (a.roi.empty()) {
+    a.note = "nothing to " + std::string(additive ? "deposit" : "remove") + " in this state";
+  } else if (p.kind == "file") {
+    throw InputError(p.name + " is a primitive from the file " + p.capability +
+                     ": no head or tool of the machine is known to make it; expected machine primitives only");
+  } else {
+    make_program(file, simulated, p, machine, options, a);
+  }
+  return a;
+}
+
 // Actions `first`.. of the plan into `out`; `present` is the material the first one meets
 // when the material present is fed back, `planned` the planned states otherwise.
 void export_from(int first, geometry::Solid present, const std::vector<geometry::Solid>& planned,
@@ -99,25 +125,11 @@ void export_from(int first, geometry::Solid present, const std::vector<geometry:
   for (int k = first; k < n; ++k) {
     if (options.progress) options.progress(k + 1, n);
     const planner::PlanFilePrimitive& p = file.primitives[std::size_t(plan.actions[std::size_t(k)].primitive)];
-    const bool additive = p.mode == planner::Mode::Additive;
-    ExportedAction a;
-    a.step = k + 1;
-    a.primitive = p.name;
-    a.before = material_after ? present : planned[std::size_t(k)];
-    a.after = material_after ? (additive ? unite(a.before, p.region) : subtract(a.before, p.region))
-                             : planned[std::size_t(k) + 1];
-    a.roi = additive ? subtract(p.region, a.before) : intersect(a.before, p.region);
-    if (p.raw_stock()) {
-      out.raw_stock = p.label;
-      a.note = "clamp the raw stock: " + p.label;
-    } else if (a.roi.empty()) {
-      a.note = "nothing to " + std::string(additive ? "deposit" : "remove") + " in this state";
-    } else if (p.kind == "file") {
-      throw InputError(p.name + " is a primitive from the file " + p.capability +
-                       ": no head or tool of the machine is known to make it; expected machine primitives only");
-    } else {
-      make_program(file, simulated, p, machine, options, a);
-    }
+    if (p.raw_stock()) out.raw_stock = p.label;
+    ExportedAction a = material_after
+                           ? make_action(k, present, nullptr, simulated, file, plan, machine, options)
+                           : make_action(k, planned[std::size_t(k)], &planned[std::size_t(k) + 1], simulated, file, plan,
+                                         machine, options);
     if (material_after) present = material_after(a);
     out.actions.push_back(std::move(a));
   }
@@ -150,6 +162,16 @@ PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePla
   out.actions = std::move(start.actions);
   export_from(first, std::move(start.present), {}, file, plan, machine, options, material_after, out);
   return out;
+}
+
+ExportedAction export_planned_action(const planner::PlanFile& file, const planner::PlanFilePlan& plan, int k,
+                                     const std::vector<geometry::Solid>& planned, const config::Machine& machine,
+                                     const ExportOptions& options) {
+  if (k < 0 || std::size_t(k) >= plan.actions.size() || planned.size() != plan.actions.size() + 1)
+    throw std::invalid_argument("export_planned_action: no action " + std::to_string(k) + " or not the plan's states");
+  check_machine(file, machine);
+  return make_action(k, planned[std::size_t(k)], &planned[std::size_t(k) + 1], planner::simulated_domain(file, plan, machine),
+                     file, plan, machine, options);
 }
 
 }  // namespace hybridctl::toolpaths

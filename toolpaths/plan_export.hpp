@@ -79,6 +79,14 @@ struct ExportStart {
 PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
                        const ExportOptions& options, const MaterialAfter& material_after, ExportStart start);
 
+// Action `k` (0-based) of `plan` as export_plan without material_after makes it: against
+// the planned states `planned` (planner::plan_states(file, plan)). It depends only on the
+// actions up to it, so plans that begin alike share it (the report exports each once).
+// std::invalid_argument for a `k` the plan does not have or states that are not its.
+ExportedAction export_planned_action(const planner::PlanFile& file, const planner::PlanFilePlan& plan, int k,
+                                     const std::vector<geometry::Solid>& planned, const config::Machine& machine,
+                                     const ExportOptions& options = {});
+
 // The path defects of the actions, each as "action K (P..): message".
 // Export refuses a plan that has any (docs/export.md): the part would be wrong.
 std::vector<std::string> path_defects(const PlanExport& exported);

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "common/error.hpp"
+#include "common/number_text.hpp"
 #include "gcode/post.hpp"
 #include "planner/start_stock.hpp"
 #include "sim/executor.hpp"
@@ -66,12 +67,14 @@ struct PrefixCacheImpl {
   std::map<std::vector<int>, std::list<Entry>::iterator> index;
   const planner::PlanFile* file = nullptr;
   const config::Machine* machine = nullptr;
+  std::optional<Solid> core;  // the file's design shrunk by its tolerance, once
 
   void clear() {
     lru.clear();
     index.clear();
     stats.entries = 0;
     stats.bytes = 0;
+    core.reset();
   }
   // Empties the cache when it is asked about another file or machine than the last.
   void serve(const planner::PlanFile& f, const config::Machine& m) {
@@ -129,6 +132,13 @@ void PrefixCache::clear() { impl_->clear(); }
 
 namespace {
 
+// The step of the plan's last action that adds material, the raw stock included (0: none).
+int last_addition(const planner::PlanFile& file, const planner::PlanFilePlan& plan) {
+  for (std::size_t k = plan.actions.size(); k > 0; --k)
+    if (file.primitives.at(std::size_t(plan.actions[k - 1].primitive)).mode == planner::Mode::Additive) return int(k);
+  return 0;
+}
+
 // The whole plan's program fed to the simulated machine action by action. After each
 // action the program of the actions made so far is posted and its lines up to the end of
 // the newest action's block are executed: the post-processor writes an action's block from
@@ -164,6 +174,33 @@ class IncrementalRun {
   // Keeps the state after every action that went right, as all before it did, in `cache`.
   void keep_in(detail::PrefixCacheImpl* cache) { cache_ = cache; }
 
+  // With RunUntil::FirstFailingAction, once the plan's last action that adds material
+  // (the raw stock counts) has run: throws Stopped when part of the design's core is missing, as
+  // the actions after it only remove. Every voxel of the core lies farther than the
+  // tolerance from the design's other side, so the part would be out of tolerance
+  // (planner/deviation.hpp, worst_out); stopping here spares running the removals.
+  void check_core_after(int step) {
+    if (options_.run_until != RunUntil::FirstFailingAction || core_checked_ || step < last_addition()) return;
+    core_checked_ = true;
+    const Solid& core = design_core();
+    const Solid missing = subtract(core, on_domain(executor_.stock(), file_));
+    if (missing.empty()) return;
+    std::optional<geometry::Vec3> where;
+    missing.for_each_voxel([&](geometry::Index3 v) {
+      if (!where) where = file_.lattice.center(v);
+    });
+    const int last = last_addition();
+    const planner::PlanFilePrimitive& p = file_.primitives.at(std::size_t(plan_.actions.at(std::size_t(last - 1)).primitive));
+    throw Stopped{step, planner::RejectionReason{
+                            "missing_material", last, 0,
+                            "after action " + std::to_string(last) + " (" + p.name +
+                                "), the last that adds material, " + fixed_number(missing.volume(), 1) +
+                                " mm^3 of the design's core (the design shrunk by the tolerance, which a part within it "
+                                "holds) is missing, and the removals after it cannot add it",
+                            where}};
+  }
+  int last_addition() const { return validation::last_addition(file_, plan_); }
+
   // The material present now, as after() returns it.
   Solid present() const { return on_domain(executor_.stock(), file_); }
 
@@ -187,15 +224,19 @@ class IncrementalRun {
     }
     const bool wrong = !made.program.path.defects.empty() || !errors_.empty() || !executor_.report().incidents.empty();
     if (options_.run_until == RunUntil::FirstFailingAction && wrong) throw Stopped{made.step};
-    // Only a prefix that went right is kept: it is the same whatever RunUntil says.
+    // Only a prefix that went right is kept: it is the same whatever RunUntil says (and
+    // whatever the plan does after it).
     right_ = right_ && !wrong;
     if (cache_ && right_) keep(made.step);
+    check_core_after(made.step);
     return on_domain(executor_.stock(), file_);
   }
 
-  // Thrown by after() to stop at the first action that went wrong.
+  // Thrown by after() to stop at the first action that went wrong; `missing` when it is
+  // the core missing after the last addition (check_core_after).
   struct Stopped {
     int action = 0;
+    std::optional<planner::RejectionReason> missing;
   };
 
   // Stopped early: what ran so far.
@@ -258,6 +299,15 @@ class IncrementalRun {
     executor_.set_protected_region(planner::spared_by_cuts(file_, &p));
   }
 
+  const Solid& design_core() {
+    if (cache_) {
+      if (!cache_->core) cache_->core = planner::spared_by_cuts(file_);
+      return *cache_->core;
+    }
+    if (!core_) core_ = planner::spared_by_cuts(file_);
+    return *core_;
+  }
+
   const config::Machine& machine_;
   const planner::PlanFile& file_;
   const planner::PlanFilePlan& plan_;
@@ -270,6 +320,8 @@ class IncrementalRun {
   int protecting_ = 0;  // the action whose spared region the executor holds (0: none yet)
   std::vector<std::string> errors_;
   detail::PrefixCacheImpl* cache_ = nullptr;
+  std::optional<Solid> core_;  // without a cache
+  bool core_checked_ = false;
   bool right_ = true;  // every action so far went right (a resumed run starts from such a prefix)
 };
 
@@ -279,6 +331,8 @@ Execution run_plan(const planner::PlanFile& file, const planner::PlanFilePlan& p
   Execution out;
   if (options.planned_against == PlannedAgainst::MaterialPresent) {
     try {
+      // A resumed prefix may already hold the last addition.
+      if (start) run.check_core_after(int(start->actions.size()));
       const toolpaths::MaterialAfter after = [&run](const toolpaths::ExportedAction& made) { return run.after(made); };
       out.exported = start ? toolpaths::export_plan(file, plan, machine, options.export_options, after, std::move(*start))
                            : toolpaths::export_plan(file, plan, machine, options.export_options, after);
@@ -286,6 +340,10 @@ Execution run_plan(const planner::PlanFile& file, const planner::PlanFilePlan& p
       run.stopped(out);
       out.stopped_after = stop.action;
       out.reasons = rejection_reasons(out, file, machine);
+      if (stop.missing) {
+        out.missing_after_last_addition = true;
+        out.reasons.push_back(*stop.missing);
+      }
       return out;
     }
   } else {
@@ -315,7 +373,25 @@ Execution execute_plan(const planner::PlanFile& file, const planner::PlanFilePla
   c.serve(file, machine);
   std::vector<int> key;
   for (const planner::PlanFileAction& a : plan.actions) key.push_back(a.primitive);
-  if (const PrefixState* from = c.longest(key)) {
+  const PrefixState* from = c.longest(key);
+  if (from && options.run_until == RunUntil::FirstFailingAction) {
+    // From the raw stock, the run stops after the last addition when the design's core is
+    // missing there (check_core_after); a prefix past it with the core missing resumes
+    // from that addition at the latest, so that the run ends the same.
+    const std::size_t last = std::size_t(last_addition(file, plan));
+    if (from->actions.size() > last) {
+      if (!c.core) c.core = planner::spared_by_cuts(file);
+      if (!subtract(*c.core, IncrementalRun(machine, file, plan, *from, options).present()).empty()) {
+        // One lookup, counted as the one that resumes.
+        --c.stats.lookups;
+        --c.stats.hits;
+        c.stats.resumed_actions -= from->actions.size();
+        key.resize(last);
+        from = c.longest(key);
+      }
+    }
+  }
+  if (from) {
     IncrementalRun run(machine, file, plan, *from, options);
     run.keep_in(&c);
     toolpaths::ExportStart start{from->actions, run.present()};

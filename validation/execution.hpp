@@ -68,6 +68,10 @@ struct Execution {
   planner::Deviation deviation;        // as built against the design
   std::vector<planner::RejectionReason> reasons;  // empty: the plan makes the part
   int stopped_after = 0;  // RunUntil::FirstFailingAction: the action it stopped after (0: ran to the end)
+  // Stopped after the plan's last action that adds material, with part of the design's
+  // core (the design shrunk by the tolerance) missing: removals alone cannot put it back,
+  // so any plan that begins with these actions and only removes after them fails alike.
+  bool missing_after_last_addition = false;
   bool proven() const { return reasons.empty(); }
 };
 

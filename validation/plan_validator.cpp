@@ -21,8 +21,15 @@ PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions option
     ExecutionOptions options;
     std::optional<planner::PlanFile> file;  // the planning result's grid, design and primitives
     // Execution is deterministic and an action depends only on the ones before it: a
-    // candidate that begins with the actions a rejected one failed in fails the same way.
-    std::vector<std::pair<std::vector<int>, std::vector<planner::RejectionReason>>> failed_prefixes;
+    // candidate that begins with the actions a rejected one failed in fails the same way;
+    // one that failed for the core missing after its last addition, so long as the
+    // candidate only removes after them (Execution::missing_after_last_addition).
+    struct FailedPrefix {
+      std::vector<int> primitives;
+      std::vector<planner::RejectionReason> reasons;
+      bool only_if_removals_follow = false;
+    };
+    std::vector<FailedPrefix> failed_prefixes;
     // ... and the same holds for the prefixes that went right: candidates go on from there.
     std::shared_ptr<PrefixCache> cache;
   };
@@ -38,17 +45,22 @@ PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions option
       state->file = planner::to_plan_file(r, sources, ".");
     }
     const planner::PlanFilePlan candidate = candidate_plan(r, plan);
-    for (const auto& [prefix, reasons] : state->failed_prefixes)
-      if (prefix.size() <= candidate.actions.size() &&
-          std::equal(prefix.begin(), prefix.end(), candidate.actions.begin(),
-                     [](int p, const planner::PlanFileAction& a) { return p == a.primitive; }))
-        return reasons;
+    const auto removes = [&](const planner::PlanFileAction& a) {
+      return state->file->primitives.at(std::size_t(a.primitive)).mode == planner::Mode::Subtractive;
+    };
+    for (const State::FailedPrefix& failed : state->failed_prefixes)
+      if (failed.primitives.size() <= candidate.actions.size() &&
+          std::equal(failed.primitives.begin(), failed.primitives.end(), candidate.actions.begin(),
+                     [](int p, const planner::PlanFileAction& a) { return p == a.primitive; }) &&
+          (!failed.only_if_removals_follow ||
+           std::all_of(candidate.actions.begin() + std::ptrdiff_t(failed.primitives.size()), candidate.actions.end(), removes)))
+        return failed.reasons;
     try {
       Execution run = execute_plan(*state->file, candidate, machine, state->options, state->cache.get());
       if (run.stopped_after > 0) {
         std::vector<int> prefix;
         for (int k = 0; k < run.stopped_after; ++k) prefix.push_back(candidate.actions[std::size_t(k)].primitive);
-        state->failed_prefixes.emplace_back(std::move(prefix), run.reasons);
+        state->failed_prefixes.push_back({std::move(prefix), run.reasons, run.missing_after_last_addition});
       }
       return std::move(run.reasons);
     } catch (const InputError& e) {

@@ -152,6 +152,39 @@ TEST(Execution, DepositOverAirIsNotLaidAndThePartLacksIt) {
   EXPECT_FALSE(run.proven());
 }
 
+// Validation stops after the plan's last addition when the design's core is missing
+// there: the removals after it cannot add it, so the part would be wrong whatever they do.
+// The reason names that action; run to the end, the deviation finds the same.
+TEST(Execution, TheCoreMissingAfterTheLastAdditionStopsTheRunThere) {
+  Case c(1.0);
+  const Solid pad = c.box({{20, 5, 0}, {30, 15, 2}}), floating = c.box({{5, 5, 6}, {15, 15, 9}});
+  c.file.design = unite(pad, floating);
+  const planner::PlanFilePlan plan =
+      c.plan({c.deposit(pad), c.deposit(floating), c.mill(c.box({{0, 0, 20}, {40, 30, 24}}), 1)});
+  ExecutionOptions validating;
+  validating.run_until = RunUntil::FirstFailingAction;
+  const Execution stopped = execute_plan(c.file, plan, machine(), validating);
+  EXPECT_EQ(stopped.stopped_after, 2) << all_reasons(stopped);
+  EXPECT_TRUE(stopped.missing_after_last_addition);
+  const planner::RejectionReason* r = first_of(stopped, "missing_material");
+  ASSERT_NE(r, nullptr) << all_reasons(stopped);
+  EXPECT_EQ(r->action, 2);
+  EXPECT_NE(r->message.find("the last that adds material"), std::string::npos) << r->message;
+  ASSERT_TRUE(r->where.has_value());
+  const geometry::Vec3 at = *r->where;
+  EXPECT_TRUE(at.x > 5 && at.x < 15 && at.y > 5 && at.y < 15 && at.z > 6 && at.z < 9) << "in the floating block";
+
+  const Execution whole = execute_plan(c.file, plan, machine());
+  EXPECT_EQ(whole.stopped_after, 0);
+  EXPECT_FALSE(whole.missing_after_last_addition);
+  EXPECT_TRUE(has(whole, "missing_material")) << all_reasons(whole);
+
+  // The same actions with the block deposited again at the end are not stopped early.
+  const planner::PlanFilePlan again = c.plan({0, 1, 2, 1});
+  const Execution later = execute_plan(c.file, again, machine(), validating);
+  EXPECT_NE(later.stopped_after, 2) << all_reasons(later);
+}
+
 // The build plate is where the simulated machine has it: a stock clamped above the
 // domain's floor has no plate under its lowest layer, so a block deposited beside it from
 // that layer is over air except where the stock's side carries the beads. The toolpath

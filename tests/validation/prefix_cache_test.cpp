@@ -139,7 +139,10 @@ TEST(PrefixCache, ResumedCandidatesEndAsFromTheRawStock) {
   const PrefixCacheStats& s = cache.stats();
   EXPECT_EQ(s.lookups, t.plans.size());
   EXPECT_EQ(s.hits, t.plans.size() - 1) << "every plan after the first begins with a prefix run before";
-  EXPECT_GE(s.resumed_actions, 2 * (t.plans.size() - 1) - 1);
+  // Most resume after two actions or more. The last {s, m} lacks the wall strip after its
+  // milling, past its last addition (the stock): it resumes from the stock, as a run from
+  // the raw stock checks the design's core there (Execution::missing_after_last_addition).
+  EXPECT_GE(s.resumed_actions, 2 * (t.plans.size() - 1) - 2);
   EXPECT_EQ(s.evicted, 0u);
   EXPECT_GT(s.bytes, 0u);
   EXPECT_LE(s.bytes, cache.max_bytes());

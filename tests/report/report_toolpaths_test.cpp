@@ -1,0 +1,117 @@
+// The report's toolpaths: each plan's actions as toolpaths::export_plan makes them against
+// the planned states, whether or not other plans begin with the same actions (the report
+// exports such shared actions once), and a plan the machine cannot make keeps its reason.
+
+#include "report/report_toolpaths.hpp"
+
+#include <gtest/gtest.h>
+
+#include "config/machine_loader.hpp"
+#include "geometry/shapes.hpp"
+#include "planner/plan_file.hpp"
+
+namespace hybridctl::report {
+namespace {
+
+using geometry::Solid;
+
+const config::Machine& machine() {
+  static const config::Machine m = config::load_machine(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
+  return m;
+}
+
+// A block from a raw stock with two overlapping steps milled from above, by the 10 mm flat
+// (P2) and the 3 mm flat (P3), in three plans: P2 then P3, P2 alone, P3 then P2.
+planner::PlanFile stepped_block() {
+  planner::PlanFile file;
+  file.machine_name = machine().name;
+  file.lattice = {0.5, {0, 0, 0}};
+  file.domain = {{0, 0, 0}, {80, 60, 48}};
+  file.tolerance = 0.5;
+  const auto box = [&](geometry::Box3 b) { return geometry::make_box(file.lattice, b); };
+  const Solid raw = box({{0, 0, 0}, {30, 20, 10}});
+  const Solid step_a = box({{20, -5, 6}, {35, 25, 15}}), step_b = box({{-5, -5, 8}, {24, 25, 15}});
+  file.design = subtract(subtract(raw, step_a), step_b);
+  const auto add = [&](const std::string& kind, planner::Mode mode, const std::string& capability, const std::string& setup,
+                       const Solid& region, int tool) {
+    planner::PlanFilePrimitive p;
+    p.name = "P" + std::to_string(file.primitives.size() + 1);
+    p.label = kind + " " + capability;
+    p.kind = kind;
+    p.mode = mode;
+    p.capability = capability;
+    p.setup = setup;
+    p.tool_number = tool;
+    p.region = intersect(region, Solid::filled(file.lattice, file.domain));
+    file.primitives.push_back(std::move(p));
+  };
+  add("raw-stock", planner::Mode::Additive, "block", "", raw, 0);
+  add("sm-max", planner::Mode::Subtractive, "T1", "top", step_a, 1);
+  add("sm-max", planner::Mode::Subtractive, "T3", "top", step_b, 3);
+  const auto plan = [](std::vector<int> actions, double cost) {
+    planner::PlanFilePlan p;
+    for (int a : actions) p.actions.push_back({a, 0, cost});
+    return p;
+  };
+  file.plans = {plan({0, 1, 2}, 1), plan({0, 1}, 2), plan({0, 2, 1}, 3)};
+  return file;
+}
+
+std::vector<std::vector<Solid>> states_of(const planner::PlanFile& file) {
+  std::vector<std::vector<Solid>> out;
+  for (const planner::PlanFilePlan& plan : file.plans) out.push_back(planner::plan_states(file, plan));
+  return out;
+}
+
+void expect_same(const ActionPath& a, const ActionPath& b, const std::string& where) {
+  EXPECT_EQ(a.step, b.step) << where;
+  EXPECT_EQ(a.primitive, b.primitive) << where;
+  EXPECT_EQ(a.makes_gcode, b.makes_gcode) << where;
+  EXPECT_EQ(a.points, b.points) << where;
+  EXPECT_EQ(a.kinds, b.kinds) << where;
+  EXPECT_EQ(a.layers, b.layers) << where;
+  EXPECT_EQ(a.cycle_s, b.cycle_s) << where;
+}
+
+TEST(ReportToolpaths, EachPlanIsAsIfExportedAloneThoughPlansShareTheirFirstActions) {
+  const planner::PlanFile file = stepped_block();
+  const std::vector<PlanPaths> all = plan_paths(file, states_of(file), machine());
+  ASSERT_EQ(all.size(), 3u);
+  for (std::size_t k = 0; k < file.plans.size(); ++k) {
+    planner::PlanFile alone = file;
+    alone.plans = {file.plans[k]};
+    const std::vector<PlanPaths> one = plan_paths(alone, states_of(alone), machine());
+    ASSERT_EQ(one.size(), 1u);
+    EXPECT_TRUE(all[k].error.empty()) << all[k].error;
+    ASSERT_EQ(all[k].actions.size(), file.plans[k].actions.size());
+    ASSERT_EQ(one[0].actions.size(), all[k].actions.size());
+    for (std::size_t a = 0; a < all[k].actions.size(); ++a)
+      expect_same(all[k].actions[a], one[0].actions[a], "plan " + std::to_string(k + 1) + " action " + std::to_string(a + 1));
+    EXPECT_EQ(all[k].line_positions.size(), one[0].line_positions.size());
+  }
+  // The stock is clamped, each step milled: the mills make G-code that cuts.
+  EXPECT_FALSE(all[0].actions[0].makes_gcode);
+  EXPECT_TRUE(all[0].actions[1].makes_gcode);
+  EXPECT_GT(all[0].actions[1].process_length, 0);
+  EXPECT_GT(all[0].actions[2].process_length, 0);
+  // P3 after P2 is not P3 from the stock: the same primitive meets other material.
+  EXPECT_EQ(all[0].actions[2].step, 3);
+  EXPECT_EQ(all[2].actions[1].step, 2);
+  EXPECT_NE(all[0].actions[2].points, all[2].actions[1].points);
+  EXPECT_FALSE(all[0].line_positions.empty());
+}
+
+TEST(ReportToolpaths, APlanTheMachineCannotMakeKeepsItsReasonAndTheOthersTheirPaths) {
+  planner::PlanFile file = stepped_block();
+  file.primitives[2].setup = "no-such-setup";
+  const std::vector<PlanPaths> all = plan_paths(file, states_of(file), machine());
+  ASSERT_EQ(all.size(), 3u);
+  EXPECT_NE(all[0].error.find("no-such-setup"), std::string::npos) << all[0].error;
+  EXPECT_TRUE(all[0].actions.empty());
+  EXPECT_TRUE(all[1].error.empty()) << all[1].error;
+  EXPECT_EQ(all[1].actions.size(), 2u);
+  EXPECT_FALSE(all[2].error.empty());
+}
+
+}  // namespace
+}  // namespace hybridctl::report
