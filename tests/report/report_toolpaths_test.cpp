@@ -6,8 +6,7 @@
 
 #include <gtest/gtest.h>
 
-#include "config/machine_loader.hpp"
-#include "geometry/shapes.hpp"
+#include "../validation/validation_cases.hpp"
 #include "planner/plan_file.hpp"
 
 namespace hybridctl::report {
@@ -15,46 +14,21 @@ namespace {
 
 using geometry::Solid;
 
-const config::Machine& machine() {
-  static const config::Machine m = config::load_machine(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
-  return m;
-}
+using validation::cases::Case;
+using validation::cases::machine;
 
 // A block from a raw stock with two overlapping steps milled from above, by the 10 mm flat
 // (P2) and the 3 mm flat (P3), in three plans: P2 then P3, P2 alone, P3 then P2.
 planner::PlanFile stepped_block() {
-  planner::PlanFile file;
-  file.machine_name = machine().name;
-  file.lattice = {0.5, {0, 0, 0}};
-  file.domain = {{0, 0, 0}, {80, 60, 48}};
-  file.tolerance = 0.5;
-  const auto box = [&](geometry::Box3 b) { return geometry::make_box(file.lattice, b); };
-  const Solid raw = box({{0, 0, 0}, {30, 20, 10}});
-  const Solid step_a = box({{20, -5, 6}, {35, 25, 15}}), step_b = box({{-5, -5, 8}, {24, 25, 15}});
-  file.design = subtract(subtract(raw, step_a), step_b);
-  const auto add = [&](const std::string& kind, planner::Mode mode, const std::string& capability, const std::string& setup,
-                       const Solid& region, int tool) {
-    planner::PlanFilePrimitive p;
-    p.name = "P" + std::to_string(file.primitives.size() + 1);
-    p.label = kind + " " + capability;
-    p.kind = kind;
-    p.mode = mode;
-    p.capability = capability;
-    p.setup = setup;
-    p.tool_number = tool;
-    p.region = intersect(region, Solid::filled(file.lattice, file.domain));
-    file.primitives.push_back(std::move(p));
-  };
-  add("raw-stock", planner::Mode::Additive, "block", "", raw, 0);
-  add("sm-max", planner::Mode::Subtractive, "T1", "top", step_a, 1);
-  add("sm-max", planner::Mode::Subtractive, "T3", "top", step_b, 3);
-  const auto plan = [](std::vector<int> actions, double cost) {
-    planner::PlanFilePlan p;
-    for (int a : actions) p.actions.push_back({a, 0, cost});
-    return p;
-  };
-  file.plans = {plan({0, 1, 2}, 1), plan({0, 1}, 2), plan({0, 2, 1}, 3)};
-  return file;
+  Case c(0.5);
+  const Solid raw = c.box({{0, 0, 0}, {30, 20, 10}});
+  const Solid step_a = c.box({{20, -5, 6}, {35, 25, 15}}), step_b = c.box({{-5, -5, 8}, {24, 25, 15}});
+  c.file.design = subtract(subtract(raw, step_a), step_b);
+  const int s = c.stock(raw), a = c.mill(step_a, 1), b = c.mill(step_b, 3);
+  c.file.plans = {c.plan({s, a, b}), c.plan({s, a}), c.plan({s, b, a})};
+  for (std::size_t k = 0; k < c.file.plans.size(); ++k)
+    for (planner::PlanFileAction& action : c.file.plans[k].actions) action.cost = double(k + 1);
+  return c.file;
 }
 
 std::vector<std::vector<Solid>> states_of(const planner::PlanFile& file) {

@@ -46,6 +46,13 @@ std::string all_reasons(const Execution& run) {
   return out;
 }
 
+// Whether the action's toolpath says it left an overhang out (docs/toolpaths.md).
+bool overhang_not_deposited(const toolpaths::ExportedAction& action) {
+  for (const std::string& w : action.program.path.warnings)
+    if (w.find("overhang") != std::string::npos && w.find("not deposited") != std::string::npos) return true;
+  return false;
+}
+
 // A block milled from a raw stock with the 10 mm flat: an open step the tool reaches.
 TEST(Execution, APlanThatMakesItsPartHasNoReason) {
   Case c(0.5);
@@ -142,10 +149,7 @@ TEST(Execution, DepositOverAirIsNotLaidAndThePartLacksIt) {
   c.file.design = unite(pad, floating);
   const Execution run = execute_plan(c.file, c.plan({c.deposit(pad), c.deposit(floating)}), machine());
   ASSERT_EQ(run.exported.actions.size(), 2u) << all_reasons(run);
-  bool not_deposited = false;
-  for (const std::string& w : run.exported.actions[1].program.path.warnings)
-    not_deposited = not_deposited || (w.find("overhang") != std::string::npos && w.find("not deposited") != std::string::npos);
-  EXPECT_TRUE(not_deposited) << all_reasons(run);
+  EXPECT_TRUE(overhang_not_deposited(run.exported.actions[1])) << all_reasons(run);
   EXPECT_FALSE(has(run, "unsupported_deposit")) << all_reasons(run);
   ASSERT_TRUE(has(run, "missing_material")) << all_reasons(run);
   EXPECT_GT(run.deviation.under_volume, 0.8 * 10 * 10 * 3) << "the floating block is missing";
@@ -196,10 +200,7 @@ TEST(Execution, ADepositBesideAStockAboveTheFloorHasNoPlateUnderIt) {
   c.file.design = unite(raw, block);
   const Execution run = execute_plan(c.file, c.plan({c.stock(raw), c.deposit(block)}), machine());
   ASSERT_EQ(run.exported.actions.size(), 2u) << all_reasons(run);
-  bool not_deposited = false;
-  for (const std::string& w : run.exported.actions[1].program.path.warnings)
-    not_deposited = not_deposited || (w.find("overhang") != std::string::npos && w.find("not deposited") != std::string::npos);
-  EXPECT_TRUE(not_deposited) << all_reasons(run);
+  EXPECT_TRUE(overhang_not_deposited(run.exported.actions[1])) << all_reasons(run);
   EXPECT_FALSE(has(run, "unsupported_deposit")) << all_reasons(run);
   EXPECT_TRUE(has(run, "missing_material")) << all_reasons(run);
 }
