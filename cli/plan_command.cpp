@@ -30,6 +30,7 @@ struct PlanArgs {
   double search_time = 0;
   std::vector<std::string> primitive_files;
   bool no_validate = false;
+  bool no_bands = false;
   int max_rejected = 200;
   bool report = false;
 };
@@ -58,6 +59,7 @@ int run_plan(const PlanArgs& args) {
   for (const std::string& p : args.primitive_files) options.extra_primitives.push_back(parse_primitive_argument(p));
   // Every plan offered is proven by execution first (validation/, docs/validation.md).
   if (!args.no_validate) options.validate = validation::plan_validator(machine);
+  options.bands = !args.no_bands;
   options.max_rejected = args.max_rejected;
   ProgressBar bar("planning");
   std::string current;
@@ -147,6 +149,9 @@ void add_plan_command(CLI::App& app, Runner& runner) {
   cmd->add_flag("--no-validate", args->no_validate,
                 "Offer the plans the search finds without executing them first (for comparison and benchmarks; "
                 "export and run still refuse a plan that does not make the part)");
+  cmd->add_flag("--no-bands", args->no_bands,
+                "Search without banded primitives (\"mill up to here, deposit from here on\", docs/bands.md): only "
+                "whole-part ones, for comparison and benchmarks");
   cmd->add_option("--max-rejected", args->max_rejected,
                   "How many candidate plans validation may turn down before the search gives up")
       ->capture_default_str()

@@ -14,6 +14,7 @@
 #include "geometry/vdb_file.hpp"
 #include "geometry/voxelize.hpp"
 #include "instruments/elements.hpp"
+#include "planner/bands.hpp"
 #include "planner/deposit_reach.hpp"
 #include "planner/memory_estimate.hpp"
 
@@ -78,11 +79,16 @@ void voxelize_design(const geometry::TriangleMesh& part, const std::string& part
 }
 
 // The machine's primitives, then those given as files.
-void add_primitives(const config::Machine& machine, const std::vector<PrimitiveFile>& files, const Progress& progress,
+void add_primitives(const config::Machine& machine, const PlanningOptions& options, const Progress& progress,
                     PlanningResult& r) {
   r.primitives = machine_primitives(machine, r.design, r.domain, [&](std::size_t done, std::size_t total, const std::string&) {
     progress("primitives", total ? double(done) / double(total) : 1.0);
   });
+  if (options.bands) {
+    for (Primitive& p : banded_primitives(machine, r.design, r.tolerance, r.domain, r.primitives))
+      r.primitives.push_back(std::move(p));
+  }
+  const std::vector<PrimitiveFile>& files = options.extra_primitives;
   for (const PrimitiveFile& f : files) {
     Primitive p;
     p.kind = PrimitiveKind::File;
@@ -264,6 +270,7 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
   // Plans that differ only in the order of one tool's consecutive actions in one setup
   // are one plan to a shop: the search keeps the cheapest order of each such block.
   search.block_orders = BlockOrders::Cheapest;
+  search.distinct_effects = true;
   search.time_limit = options.search_time;
   search.accept = accept_hook(options, r, validation_seconds);
   search.max_rejected = options.max_rejected;
@@ -320,7 +327,7 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
   check_planning_memory(geometry::bounds(part), machine, h, r.tolerance, options.memory_budget, part_name);
   voxelize_design(part, part_name, machine, h, progress, r);
   clock.lap("voxelize");
-  add_primitives(machine, options.extra_primitives, progress, r);
+  add_primitives(machine, options, progress, r);
   clock.lap("primitives");
   decompose_into_atoms(progress, r);
   clock.lap("atoms");

@@ -39,6 +39,8 @@ struct PlanningOptions {
   // Wall-clock budget of the plan search in seconds (SearchOptions::time_limit; 0: none).
   double search_time = 0;
   std::vector<PrimitiveFile> extra_primitives;
+  // Banded primitives (planner/bands.hpp): "mill up to here, deposit from here on".
+  bool bands = true;
   // Bytes planning may take (planner/memory_estimate.hpp); 0: half the physical memory.
   std::uint64_t memory_budget = 0;
   // Progress: a phase name and a fraction of it done.

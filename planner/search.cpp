@@ -157,6 +157,25 @@ std::vector<int> sequence_of(const Plan& plan) {
   return s;
 }
 
+// What a plan does, step by step: each step's tool, setup and mode and the atoms it
+// changes. Two plans with the same effect differ only in which primitive names a step
+// (a whole-part deposit after a band was milled deposits what the band's deposit would).
+std::vector<std::uint64_t> effect_of(const PlanningProblem& p, const std::vector<int>& sequence) {
+  std::vector<std::uint64_t> key;
+  AtomSet state(int(p.atoms.size()));
+  auto& s = state.words();
+  for (const int i : sequence) {
+    const PrimitiveSpec& prim = p.primitives[std::size_t(i)];
+    key.push_back(std::hash<std::string>{}(prim.tool + '\n' + prim.setup) ^ std::uint64_t(prim.mode == Mode::Additive));
+    const auto& a = prim.atoms.words();
+    for (std::size_t w = 0; w < s.size(); ++w) {
+      key.push_back(prim.mode == Mode::Additive ? a[w] & ~s[w] : a[w] & s[w]);
+      s[w] = prim.mode == Mode::Additive ? s[w] | a[w] : s[w] & ~a[w];
+    }
+  }
+  return key;
+}
+
 using Clock = std::chrono::steady_clock;
 
 // Whether `next` may follow `last` when one order per block is kept: within a block
@@ -174,7 +193,10 @@ class Search {
  public:
   Search(const PlanningProblem& p, const SearchOptions& o, const LowerBound& bound, Clock::time_point deadline,
          const std::set<std::vector<int>>& known, SearchStats& st, double prune_at = kInfinity)
-      : p_(p), o_(o), bound_(bound), deadline_(deadline), known_(known), st_(st), prune_at_(prune_at) {}
+      : p_(p), o_(o), bound_(bound), deadline_(deadline), known_(known), st_(st), prune_at_(prune_at) {
+    if (o_.distinct_effects)
+      for (const std::vector<int>& k : known_) effects_.insert(effect_of(p_, k));
+  }
 
   // Accepted plans not in `known`, cheapest first (by f), at most `wanted`.
   std::vector<Plan> run(int wanted);
@@ -210,6 +232,8 @@ class Search {
   std::int64_t seq_ = 0;
   double frontier_ = kInfinity;
   bool limit_ = false;
+  std::set<std::vector<std::uint64_t>> effects_;  // of the plans returned or known (distinct_effects)
+  std::int64_t same_effect_ = 0;  // goal plans skipped as doing what one returned does
 };
 
 bool Search::out_of_room() const {
@@ -272,7 +296,7 @@ std::vector<Plan> Search::run(int wanted) {
     if (e.node != 0) {
       int& count = pops[key_of(node)];
       // k cheapest arrivals at this key suffice, plus one for each plan turned down.
-      if (count >= o_.top_k + (st_.rejected - rejected_before)) {
+      if (count >= o_.top_k + (st_.rejected - rejected_before) + same_effect_) {
         open_.pop();
         continue;
       }
@@ -282,6 +306,10 @@ std::vector<Plan> Search::run(int wanted) {
       open_.pop();
       Plan plan = plan_from(nodes_, e.node);
       if (known_.count(sequence_of(plan))) continue;
+      if (o_.distinct_effects && !effects_.insert(effect_of(p_, sequence_of(plan))).second) {
+        ++same_effect_;
+        continue;
+      }
       if (!o_.accept || o_.accept(plan)) {
         plans.push_back(std::move(plan));
       } else if (++st_.rejected >= o_.max_rejected) {

@@ -120,6 +120,9 @@ struct SearchOptions {
   std::function<bool(const Plan&)> accept;
   std::int64_t max_rejected = 50;
   BlockOrders block_orders = BlockOrders::Every;
+  // Plans that do the same thing step by step (each step's tool, setup, mode and the atoms
+  // it changes) are one plan to a shop: keep only the first, the cheapest, of them.
+  bool distinct_effects = false;
   // Wall-clock budget of the whole search in seconds (0: none). When the exact search has
   // not finished in half of it, weighted A* finds plans in the rest, each with its proven
   // gap. A budget makes the result depend on the machine's speed; the expansion and state

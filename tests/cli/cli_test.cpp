@@ -168,6 +168,28 @@ TEST_F(Cli, PlansTheFlangedHubAndWritesPlanJsonWithValidPlans) {
   EXPECT_EQ(run({"plan", "--no-validate", kFlangedHub, "--machine", kMachine, "--voxel", "1", "--top", "2", "-o", (dir_ / "plan").string()}).exit_code, 0);
 }
 
+// A block with a closed channel whose pointed roof builds without support: every plan
+// offered mills the block up to the channel's floor and deposits only the band above it
+// (docs/bands.md), and each one, exported and run on its own simulated controller from the
+// raw stock, makes the part within tolerance both ways with no alarm.
+TEST_F(Cli, EveryPlanOfTheArchChannelBlockMillsToTheChannelFloorAndRunsWithinTolerance) {
+  const Outcome r = run({"dry-run", std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/arch-channel-block.stl", "--machine",
+                         kMachine, "--all", "-o", (dir_ / "dry").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("dry-run     5 of 5 plans ran to the end with no alarm, within tolerance both ways"), std::string::npos)
+      << r.out;
+  // The band's milling primitive is in every plan: "P19 ... down to z = 22 mm".
+  const std::regex milled("\\n  (P[0-9]+) +SM-max T1 \\(10 mm flat rougher\\) from \\+Z \\(top\\), down to z = 22 mm");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.out, m, milled)) << r.out;
+  const std::string band = m[1];
+  std::size_t plans = 0;
+  const std::regex plan_line("\nplan [0-9]+ +(\\(.*)  cost");
+  for (std::sregex_iterator it(r.out.begin(), r.out.end(), plan_line), end; it != end; ++it, ++plans)
+    EXPECT_NE((*it)[1].str().find(band + ")"), std::string::npos) << (*it)[1];
+  EXPECT_EQ(plans, 5u) << r.out;
+}
+
 // The bracket's horizontal hole has a roof that no deposit from +Z holds up (it overhangs
 // far past the head's 30 degrees) and that a deposit from -Z, turned over, could only lay
 // under the material already there. The planner proves that no order of its primitives

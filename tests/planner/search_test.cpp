@@ -272,6 +272,63 @@ TEST(Search, OneOrderPerBlockFindsTheOptimumAndTheCheapestPlansInBlockOrder) {
 
 // Two removals with one tool: the cheaper must go first, since the atoms both hold are
 // paid at the rate of whichever comes first. One order per block keeps that one.
+// What a plan does step by step: each step's tool, setup and mode and the atoms it changes.
+std::vector<std::string> effect(const PlanningProblem& p, const Plan& plan) {
+  std::vector<std::string> out;
+  AtomSet state(int(p.atoms.size()));
+  for (const PlanStep& step : plan.steps) {
+    const PrimitiveSpec& prim = p.primitives[std::size_t(step.primitive)];
+    std::string e = prim.tool + "|" + prim.setup + "|" + (prim.mode == Mode::Additive ? "+" : "-");
+    for (int a = 0; a < int(p.atoms.size()); ++a) {
+      const bool changes = prim.atoms.test(a) && (prim.mode == Mode::Additive) != state.test(a);
+      if (changes) e += " " + std::to_string(a);
+      if (prim.atoms.test(a)) state.set(a, prim.mode == Mode::Additive);
+    }
+    out.push_back(e);
+  }
+  return out;
+}
+
+TEST(Search, PlansThatDoTheSameStepByStepAreOnePlanTheCheapestKept) {
+  std::mt19937 rng(16);
+  int merged = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    VoxelProblem vp = random_instance(rng, 2 + trial % 3);
+    // A band of each primitive, as planner/bands.hpp makes them: its upper half, with its
+    // tool and cost.
+    std::vector<VoxelPrimitive> prims = vp.primitives;
+    std::vector<std::size_t> parent;
+    for (std::size_t i = 0; i < vp.primitives.size(); ++i) parent.push_back(i);
+    for (std::size_t i = 0; i < vp.primitives.size(); ++i) {
+      const VoxelPrimitive& p = vp.primitives[i];
+      if (p.raw) continue;
+      const IndexBox b = p.region.bounding_box();
+      const IndexBox upper{{b.lo.x, b.lo.y, (b.lo.z + b.hi.z) / 2}, b.hi};
+      prims.push_back({p.name + "b", p.mode, false, p.cost, intersect(p.region, Solid::filled(kUnit, upper))});
+      parent.push_back(i);
+    }
+    vp = make_problem(std::move(prims), vp.design, vp.domain);
+    for (std::size_t i = 0; i < vp.problem.primitives.size(); ++i)
+      vp.problem.primitives[i].tool = "T" + std::to_string(parent[i] % 2);
+    // The oracle: every plan, cheapest first, the first of each effect kept.
+    std::vector<Plan> distinct;
+    std::set<std::vector<std::string>> seen;
+    for (const Plan& plan : enumerate_plans(vp.problem))
+      if (seen.insert(effect(vp.problem, plan)).second) distinct.push_back(plan);
+      else ++merged;
+    SearchOptions options{5};
+    options.distinct_effects = true;
+    const auto found = find_plans(vp.problem, options);
+    ASSERT_EQ(found.size(), std::min<std::size_t>(5, distinct.size())) << "trial " << trial;
+    std::set<std::vector<std::string>> effects;
+    for (std::size_t i = 0; i < found.size(); ++i) {
+      EXPECT_NEAR(found[i].cost, distinct[i].cost, 1e-9 * std::max(1.0, distinct[i].cost)) << "trial " << trial;
+      EXPECT_TRUE(effects.insert(effect(vp.problem, found[i])).second) << "trial " << trial;
+    }
+  }
+  EXPECT_GT(merged, 20);  // the instances do hold plans that do the same thing
+}
+
 TEST(Search, ARemovalWhoseCostDependsOnTheOrderIsCostedInItsCheapestOrder) {
   // Atoms: 0 core (must-in), 1 in both removals, 2 only in the dear one, 3 only in the
   // cheap one (all must-out); the stock holds them all.
