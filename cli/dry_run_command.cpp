@@ -41,6 +41,7 @@ struct DryRunArgs {
   bool all = false;
   double voxel = 0;
   std::string memory_budget;
+  std::vector<std::string> stock_files;
   double time_scale = 0;
   bool report = false;
 };
@@ -174,6 +175,7 @@ int run_dry_run(const DryRunArgs& a) {
   options.voxel_size = a.voxel;
   options.memory_budget = memory_budget(a.memory_budget);
   options.validate = validation::plan_validator(machine);
+  options.stock_files = a.stock_files;
   const planner::PlanningResult planned = planner::plan_part(geometry::read_stl(a.part), a.part, machine, options);
   const planner::ReportSources sources{a.part, a.machine, machine.name, machine_text};
   std::fputs(planner::plan_summary(planned, sources).c_str(), stdout);
@@ -224,6 +226,9 @@ void add_dry_run_command(CLI::App& app, Runner& runner) {
   add_memory_budget_option(cmd, a->memory_budget);
   cmd->add_flag("--report", a->report,
                 "Also write the job report with what the run built and its alarms, DIR/report.html and its PNG snapshots");
+  cmd->add_option("--stock", a->stock_files,
+                  "Raw stock as a file (STL, or .vdb on the plan's voxel grid) in the part's frame, as for `plan`; "
+                  "repeatable");
   cmd->add_option("--time-scale", a->time_scale, "Simulated seconds per real second (0: as fast as possible)")
       ->capture_default_str()
       ->check(at_least(0));

@@ -29,6 +29,7 @@ struct PlanArgs {
   int reuse = 1;
   double search_time = 0;
   std::vector<std::string> primitive_files;
+  std::vector<std::string> stock_files;
   bool no_validate = false;
   bool no_bands = false;
   int max_rejected = 200;
@@ -57,6 +58,7 @@ int run_plan(const PlanArgs& args) {
   options.max_uses = args.reuse;
   options.search_time = args.search_time;
   for (const std::string& p : args.primitive_files) options.extra_primitives.push_back(parse_primitive_argument(p));
+  options.stock_files = args.stock_files;
   // Every plan offered is proven by execution first (validation/, docs/validation.md).
   if (!args.no_validate) options.validate = validation::plan_validator(machine);
   options.bands = !args.no_bands;
@@ -146,6 +148,9 @@ void add_plan_command(CLI::App& app, Runner& runner) {
       ->check(greater_than(0));
   cmd->add_option("--primitive", args->primitive_files,
                   "Extra primitive FILE:am or FILE:sm (STL, or .vdb on the plan's voxel grid); repeatable");
+  cmd->add_option("--stock", args->stock_files,
+                  "Raw stock as a file (STL, or .vdb on the plan's voxel grid) in the part's frame: a casting, a blank, "
+                  "a worn part to repair; replaces the machine file's raw stocks; repeatable");
   cmd->add_flag("--no-validate", args->no_validate,
                 "Offer the plans the search finds without executing them first (for comparison and benchmarks; "
                 "export and run still refuse a plan that does not make the part)");

@@ -58,7 +58,8 @@ std::size_t machine_primitive_count(const config::Machine& m) {
 }
 
 std::vector<Primitive> machine_primitives(const config::Machine& m, const Solid& design,
-                                          const geometry::IndexBox& domain, const PrimitiveProgress& progress) {
+                                          const geometry::IndexBox& domain, const PrimitiveProgress& progress,
+                                          const Solid* present) {
   std::vector<Primitive> out;
   const geometry::Lattice& lattice = design.lattice();
   const geometry::Box3 bb = design.bounding_box_mm();
@@ -108,7 +109,7 @@ std::vector<Primitive> machine_primitives(const config::Machine& m, const Solid&
         // Only what the head builds without support in this setup (planner/support.hpp).
         const auto buildable = [&](const Solid& region) {
           return self_supporting(region, instruments::approach_direction(setup.approach),
-                                 instruments::support_rule(head.support, design.voxel_size()));
+                                 instruments::support_rule(head.support, design.voxel_size()), present);
         };
         if (kind == config::PrimitiveKind::UAm) {
           p.kind = PrimitiveKind::UAm;

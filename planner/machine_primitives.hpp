@@ -28,6 +28,7 @@ struct Primitive {
   int tool_number = 0;       // for cutting tools
   double cost_per_mm3 = 0;
   geometry::Solid region;    // deposited (additive) or removed (subtractive) region
+  bool from_file = false;    // a raw stock given as a file: `capability` is its path
 };
 
 // The structuring elements of a head's bead and of a tool's cutting part and body, in
@@ -43,8 +44,11 @@ using PrimitiveProgress = std::function<void(std::size_t done, std::size_t total
 // tool's primitive kinds over the setups.
 std::size_t machine_primitive_count(const config::Machine& machine);
 
-// Stocks first, then heads, then tools, each over the machine's setups.
+// Stocks first, then heads, then tools, each over the machine's setups. `present`, when
+// given, is the stock every plan starts from: deposits are cut to what builds on the plate
+// or on it (planner/support.hpp).
 std::vector<Primitive> machine_primitives(const config::Machine& machine, const geometry::Solid& design,
-                                          const geometry::IndexBox& domain, const PrimitiveProgress& progress = {});
+                                          const geometry::IndexBox& domain, const PrimitiveProgress& progress = {},
+                                          const geometry::Solid* present = nullptr);
 
 }  // namespace hybridctl::planner

@@ -181,7 +181,7 @@ std::string path_from_plan_directory(const std::string& path, const std::filesys
 }
 
 std::string primitive_capability(const Primitive& p, const std::filesystem::path& directory) {
-  return p.kind == PrimitiveKind::File ? path_from_plan_directory(p.capability, directory) : p.capability;
+  return p.kind == PrimitiveKind::File || p.from_file ? path_from_plan_directory(p.capability, directory) : p.capability;
 }
 
 std::string plan_json(const PlanningResult& r, const ReportSources& src, const std::filesystem::path& directory) {

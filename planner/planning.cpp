@@ -81,9 +81,37 @@ void voxelize_design(const geometry::TriangleMesh& part, const std::string& part
 // The machine's primitives, then those given as files.
 void add_primitives(const config::Machine& machine, const PlanningOptions& options, const Progress& progress,
                     PlanningResult& r) {
-  r.primitives = machine_primitives(machine, r.design, r.domain, [&](std::size_t done, std::size_t total, const std::string&) {
-    progress("primitives", total ? double(done) / double(total) : 1.0);
-  });
+  config::Machine without_stocks;
+  std::vector<Primitive> stocks;
+  for (const std::string& file : options.stock_files) {
+    Primitive p;
+    p.kind = PrimitiveKind::RawStock;
+    p.mode = Mode::Additive;
+    p.capability = file;
+    p.from_file = true;
+    p.label = "raw stock from " + file;
+    p.region = intersect(load_primitive_file({file, Mode::Additive, 0}, r.lattice), Solid::filled(r.lattice, r.domain));
+    if (p.region.empty())
+      throw InputError(file + ": the stock has no voxel inside the planning domain around the part; expected a stock "
+                       "placed in the part's frame, over the part");
+    stocks.push_back(std::move(p));
+  }
+  if (!stocks.empty()) {
+    // The stocks given replace the machine file's: the shop says what it starts from.
+    without_stocks = machine;
+    without_stocks.raw_stocks.clear();
+  }
+  const config::Machine& offering = stocks.empty() ? machine : without_stocks;
+  // One stock given: every plan starts on it, and deposits may build on it.
+  const Solid* present = stocks.size() == 1 ? &stocks.front().region : nullptr;
+  r.primitives = machine_primitives(
+      offering, r.design, r.domain,
+      [&](std::size_t done, std::size_t total, const std::string&) {
+        progress("primitives", total ? double(done) / double(total) : 1.0);
+      },
+      present);
+  r.primitives.insert(r.primitives.begin(), std::make_move_iterator(stocks.begin()), std::make_move_iterator(stocks.end()));
+  for (std::size_t i = 0; i < r.primitives.size(); ++i) r.primitives[i].name = "P" + std::to_string(i + 1);
   if (options.bands) {
     for (Primitive& p : banded_primitives(machine, r.design, r.tolerance, r.domain, r.primitives))
       r.primitives.push_back(std::move(p));
@@ -332,6 +360,7 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
   decompose_into_atoms(progress, r);
   clock.lap("atoms");
   r.problem = symbolic_problem(r, machine, options.max_uses);
+  r.problem.start_from_stock = !options.stock_files.empty();
   r.verdict = check_manufacturability(r.problem, r.measures, r.lattice);
   clock.lap("check");
   double validation_seconds = 0;

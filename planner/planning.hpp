@@ -41,6 +41,9 @@ struct PlanningOptions {
   std::vector<PrimitiveFile> extra_primitives;
   // Banded primitives (planner/bands.hpp): "mill up to here, deposit from here on".
   bool bands = true;
+  // Raw stocks as files (STL or .vdb on the plan's grid) in the part's frame: a casting, a
+  // blank, a worn part to repair. When given, they replace the machine file's raw stocks.
+  std::vector<std::string> stock_files;
   // Bytes planning may take (planner/memory_estimate.hpp); 0: half the physical memory.
   std::uint64_t memory_budget = 0;
   // Progress: a phase name and a fraction of it done.

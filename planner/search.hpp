@@ -63,6 +63,9 @@ struct PlanningProblem {
   // different parts compare; 1 leaves them in cost units.
   double normaliser = 1.0;
   int max_uses = 1;  // how often one primitive may appear in a plan
+  // Every plan begins with a raw stock (the shop's own stock was given: a repair starts from
+  // the worn part, not from an empty plate).
+  bool start_from_stock = false;
 };
 
 struct PlanStep {

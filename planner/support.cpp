@@ -36,7 +36,7 @@ struct LayerFrame {
 }  // namespace
 
 geometry::Solid self_supporting(const geometry::Solid& region, geometry::AxisDirection build,
-                                const instruments::SupportRule& rule) {
+                                const instruments::SupportRule& rule, const geometry::Solid* present) {
   geometry::Solid out(region.lattice(), region.storage_box());
   const IndexBox bb = region.bounding_box();
   if (bb.empty()) return out;
@@ -46,7 +46,7 @@ geometry::Solid self_supporting(const geometry::Solid& region, geometry::AxisDir
   const int nu = hi[0] - lo[0], nv = hi[1] - lo[1], layers = hi[2] - lo[2];
   const LayerGrid empty(lo[0], lo[1], nu, nv);
   // The layers built so far, held and bridged, from the first (on the plate).
-  std::vector<LayerGrid> held, bridged;
+  std::vector<LayerGrid> held, bridged, present_cells;
   std::vector<instruments::Below> below;
   for (int i = 0; i < layers; ++i) {
     const int w = build.sign > 0 ? lo[2] + i : hi[2] - 1 - i;
@@ -61,12 +61,24 @@ geometry::Solid self_supporting(const geometry::Solid& region, geometry::AxisDir
       for (int j = i - n + 1; rule.max_bridge_voxels > 0 && j < i; ++j)
         for (std::size_t c = 0; c < target.material.cells.size(); ++c)
           target.material.cells[c] |= bridged[std::size_t(j)].cells[c];
+      // Material there before the build is a foundation: what it holds in the layers since
+      // counts for every look-back, as the layer under a deposit is all a bead needs.
+      for (int j = i - n + 1; present && j < i; ++j)
+        for (std::size_t c = 0; c < target.material.cells.size(); ++c)
+          target.material.cells[c] |= present_cells[std::size_t(j)].cells[c];
       below.push_back(std::move(target));
     }
     instruments::HeldCells layer = instruments::supported_cells(candidates, below, empty, rule);
+    if (present) {
+      LayerGrid there = empty;
+      for (int v = lo[1]; v < hi[1]; ++v)
+        for (int u = lo[0]; u < hi[0]; ++u)
+          if (present->contains(frame.voxel(u, v, w))) layer.held.set(u, v), there.set(u, v);
+      present_cells.push_back(std::move(there));
+    }
     for (int v = lo[1]; v < hi[1]; ++v)
       for (int u = lo[0]; u < hi[0]; ++u)
-        if (layer.held.filled(u, v)) out.set(frame.voxel(u, v, w));
+        if (layer.held.filled(u, v) && candidates.filled(u, v)) out.set(frame.voxel(u, v, w));
     held.push_back(std::move(layer.held));
     bridged.push_back(std::move(layer.bridged));
   }

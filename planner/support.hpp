@@ -22,7 +22,9 @@ namespace hybridctl::planner {
 
 // The self-supporting part of `region` built along `build` (the setup's approach: the
 // head comes from that side, layers stack towards it).
+// `present`, when given, is material there before the build (a stock to build on): its
+// voxels hold in every layer, and carry what is built over and beside them.
 geometry::Solid self_supporting(const geometry::Solid& region, geometry::AxisDirection build,
-                                const instruments::SupportRule& rule);
+                                const instruments::SupportRule& rule, const geometry::Solid* present = nullptr);
 
 }  // namespace hybridctl::planner
