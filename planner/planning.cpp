@@ -78,7 +78,8 @@ void voxelize_design(const geometry::TriangleMesh& part, const std::string& part
   r.design = intersect(r.design, Solid::filled(r.lattice, r.domain));
 }
 
-// The machine's primitives, then those given as files.
+// The raw stocks given as files (else the machine's), the machine's primitives (deposits cut
+// to what builds on the one stock given), the banded ones, then primitives given as files.
 void add_primitives(const config::Machine& machine, const PlanningOptions& options, const Progress& progress,
                     PlanningResult& r) {
   config::Machine without_stocks;
