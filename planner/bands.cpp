@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <set>
 
 #include "instruments/elements.hpp"
@@ -152,6 +153,25 @@ std::vector<BandLevel> band_levels(const Solid& design, const Solid& enclosed, A
       out.push_back(l);
   }
   return out;
+}
+
+std::size_t max_banded_primitive_count(const config::Machine& machine) {
+  // Per approach direction: each setup's deposits and one cutter; the levels go to at most
+  // kMaxBandLevels directions, the largest counted each time.
+  bool cutter = false;
+  for (const config::CuttingTool& t : machine.tools)
+    cutter = cutter || std::find(t.primitives.begin(), t.primitives.end(), config::PrimitiveKind::SmMax) != t.primitives.end();
+  std::map<std::pair<int, int>, std::size_t> per_direction;
+  for (const config::Setup& setup : machine.setups) {
+    std::size_t am = 0;
+    for (const config::AdditiveHead& head : machine.heads) am += head.primitives.size();
+    if (am == 0) continue;
+    const AxisDirection d = instruments::approach_direction(setup.approach);
+    per_direction[{int(d.axis), d.sign}] += am + (cutter ? 1 : 0);
+  }
+  std::size_t largest = 0;
+  for (const auto& [direction, n] : per_direction) largest = std::max(largest, n);
+  return std::size_t(kMaxBandLevels) * largest;
 }
 
 std::vector<Primitive> banded_primitives(const config::Machine& machine, const Solid& design, double tolerance,

@@ -53,6 +53,10 @@ std::vector<BandLevel> band_levels(const geometry::Solid& design, const geometry
 // The voxels of `domain` beyond `level`.
 geometry::Solid beyond(const geometry::Lattice& lattice, const geometry::IndexBox& domain, const BandLevel& level);
 
+// The most banded primitives banded_primitives may add for `machine`, whatever the part: for
+// the memory check before anything is computed.
+std::size_t max_banded_primitive_count(const config::Machine& machine);
+
 // The banded primitives of `machine` for `primitives` (its whole-part ones, as
 // machine_primitives returns them): the best kMaxBandLevels levels over every approach,
 // and per level and setup with that approach every head's AM kinds and the cheapest SM-max
