@@ -17,6 +17,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/memory_budget.hpp"
+#include "cli/objective.hpp"
 #include "cli/ranges.hpp"
 #include "cli/report_job.hpp"
 #include "cli/run_job.hpp"
@@ -42,6 +43,7 @@ struct DryRunArgs {
   double voxel = 0;
   std::string memory_budget;
   std::vector<std::string> stock_files;
+  std::string objective;
   double time_scale = 0;
   bool report = false;
 };
@@ -176,6 +178,7 @@ int run_dry_run(const DryRunArgs& a) {
   options.memory_budget = memory_budget(a.memory_budget);
   options.validate = validation::plan_validator(machine);
   options.stock_files = a.stock_files;
+  options.objective = objective(a.objective);
   const planner::PlanningResult planned = planner::plan_part(geometry::read_stl(a.part), a.part, machine, options);
   const planner::ReportSources sources{a.part, a.machine, machine.name, machine_text};
   std::fputs(planner::plan_summary(planned, sources).c_str(), stdout);
@@ -229,6 +232,7 @@ void add_dry_run_command(CLI::App& app, Runner& runner) {
   cmd->add_option("--stock", a->stock_files,
                   "Raw stock as a file (STL, or .vdb on the plan's voxel grid) in the part's frame, as for `plan`; "
                   "repeatable");
+  add_objective_option(cmd, a->objective);
   cmd->add_option("--time-scale", a->time_scale, "Simulated seconds per real second (0: as fast as possible)")
       ->capture_default_str()
       ->check(at_least(0));

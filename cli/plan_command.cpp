@@ -4,6 +4,7 @@
 
 #include "cli/commands.hpp"
 #include "cli/memory_budget.hpp"
+#include "cli/objective.hpp"
 #include "cli/ranges.hpp"
 #include "cli/export_run.hpp"
 #include "cli/progress.hpp"
@@ -32,6 +33,7 @@ struct PlanArgs {
   std::vector<std::string> stock_files;
   bool no_validate = false;
   bool no_bands = false;
+  std::string objective;
   int max_rejected = 200;
   bool report = false;
 };
@@ -62,6 +64,7 @@ int run_plan(const PlanArgs& args) {
   // Every plan offered is proven by execution first (validation/, docs/validation.md).
   if (!args.no_validate) options.validate = validation::plan_validator(machine);
   options.bands = !args.no_bands;
+  options.objective = objective(args.objective);
   options.max_rejected = args.max_rejected;
   ProgressBar bar("planning");
   std::string current;
@@ -157,6 +160,7 @@ void add_plan_command(CLI::App& app, Runner& runner) {
   cmd->add_flag("--no-bands", args->no_bands,
                 "Search without banded primitives (\"mill up to here, deposit from here on\", docs/bands.md): only "
                 "whole-part ones, for comparison and benchmarks");
+  add_objective_option(cmd, args->objective);
   cmd->add_option("--max-rejected", args->max_rejected,
                   "How many candidate plans validation may turn down before the search gives up")
       ->capture_default_str()

@@ -89,6 +89,27 @@ constexpr double default_standoff(DepositionProcess p) {
   return p == DepositionProcess::WireArc ? 15.0 : 10.0;
 }
 
+/// What a head's deposit is made of, for what it costs (docs/costs.md).
+struct DepositMaterial {
+  double density = 7.9;                 ///< g/cm³ (316L stainless steel); > 0
+  double price_per_kg = 0.0;            ///< money per kg bought, >= 0; default by process
+  double efficiency = 1.0;              ///< fraction of the material fed that ends in the part, 0 < e <= 1; default by process
+};
+
+/// Material of a head when the machine file gives none: 316L, as gas-atomised powder for
+/// powder DED (about 40 per kg; a coaxial nozzle catches about 70 % of the powder), as
+/// welding wire for the wire processes (about 15 per kg; wire-arc loses about 5 % to
+/// spatter, laser wire about 2 %). Placeholders from public list prices: set your own.
+constexpr DepositMaterial default_material(DepositionProcess p) {
+  switch (p) {
+    case DepositionProcess::DedPowder: return {7.9, 40.0, 0.7};
+    case DepositionProcess::DedWire: return {7.9, 15.0, 0.98};
+    case DepositionProcess::LaserWire: return {7.9, 15.0, 0.98};
+    case DepositionProcess::WireArc: return {7.9, 15.0, 0.95};
+  }
+  return {};
+}
+
 enum class BeadShape { Ellipsoid, Cylinder };
 
 /// The cross-section one pass deposits: the head's minimum manufacturable neighbourhood.
@@ -130,7 +151,10 @@ struct AdditiveHead {
   /// unique among heads and never a cutting tool's number.
   int tool_number = 0;
   DepositionCodes codes;
-  double cost_per_mm3 = 1.0;            ///< cost factor per mm³ deposited, >= 0
+  double cost_per_mm3 = 1.0;            ///< cost factor per mm³ deposited, >= 0 (objective cost-factor)
+  /// mm³ per minute of deposition, > 0; 0 in the model: not given (volume_rate()).
+  double deposition_rate = 0.0;
+  DepositMaterial material = default_material(DepositionProcess::DedPowder);  ///< default by process
   std::vector<PrimitiveKind> primitives = {PrimitiveKind::UAm, PrimitiveKind::OAm};
 
   bool offers(PrimitiveKind k) const {
@@ -138,6 +162,9 @@ struct AdditiveHead {
       if (p == k) return true;
     return false;
   }
+  /// mm³/min in force: the machine file's deposition_rate, else one layer of tracks at the
+  /// hatch spacing laid at the feed.
+  double volume_rate() const { return deposition_rate > 0 ? deposition_rate : layer_height * hatch_spacing * feed; }
 };
 
 /// The default head tool number is this plus the head's index in the machine file.
@@ -171,11 +198,18 @@ struct CuttingTool {
   double plunge_feed = 300.0;           ///< mm/min, > 0
   double step_down = 0.0;               ///< mm, 0 < d <= flute_length; default 0.5 x diameter
   double step_over = 0.0;               ///< mm, 0 < s <= diameter; default 0.4 x diameter
-  double cost_per_mm3 = 1.0;            ///< cost factor per mm³ removed, >= 0
+  double cost_per_mm3 = 1.0;            ///< cost factor per mm³ removed, >= 0 (objective cost-factor)
+  /// mm³ per minute of cutting, > 0; 0 in the model: not given (volume_rate()).
+  double removal_rate = 0.0;
+  double tool_price = 60.0;             ///< money per tool, >= 0: what wearing one out costs
+  double tool_life = 90.0;              ///< minutes of cutting a tool lasts, > 0
   std::vector<PrimitiveKind> primitives = {PrimitiveKind::SmMax, PrimitiveKind::SmCons};
 
   /// Flute + shank + holder: how far the tool assembly reaches below the spindle nose.
   double stick_out() const { return flute_length + shank.length + holder.length; }
+  /// mm³/min in force: the machine file's removal_rate, else a full step-down and
+  /// step-over at the feed.
+  double volume_rate() const { return removal_rate > 0 ? removal_rate : step_down * step_over * feed; }
   bool offers(PrimitiveKind k) const {
     for (auto p : primitives)
       if (p == k) return true;
@@ -214,16 +248,37 @@ struct Setup {
 
 enum class Axis { X, Y, Z };
 
-/// A raw stock: a box around the part's bounding box, or a round bar.
+/// A raw stock: a box around the part's bounding box, a round bar, or a plate of a given
+/// thickness under the part (its underside at the part's lowest face, its sides `margin`
+/// out from the part's on X and Y).
 struct RawStock {
-  enum class Kind { Box, RoundBar };
+  enum class Kind { Box, RoundBar, Plate };
   std::string name;                     ///< unique; required
   Kind kind = Kind::Box;
   std::array<double, 3> margin = {1.0, 1.0, 1.0};  ///< box: mm added on each side in X, Y, Z, >= 0
   double bar_diameter = 0.0;            ///< round bar: mm, > 0
   double bar_length = 0.0;              ///< round bar: mm, > 0
   Axis bar_axis = Axis::Z;              ///< round bar: its axis in the part frame
+  double plate_thickness = 0.0;         ///< plate: mm, > 0 (margin[0] and margin[1] hold its margins)
+  double density = 7.9;                 ///< g/cm³ of the stock's material, > 0
+  double price_per_kg = 6.0;            ///< money per kg of stock bought (316L bar or plate), >= 0
 };
+
+/// What the machine's time and the changes between actions cost (docs/costs.md). The
+/// defaults are placeholders from public figures for a hybrid DED-milling cell: set the
+/// shop's own.
+struct Costs {
+  std::string currency = "EUR";         ///< a label for money amounts
+  double machine_rate = 120.0;          ///< money per hour of machine time, operator included, >= 0
+  double tool_change = 8.0;             ///< s: an automatic tool change (or head to head), >= 0
+  double head_switch = 60.0;            ///< s: between milling and deposition (head in, gas and powder settled), >= 0
+  double setup_change = 10.0;           ///< s: to another setup's rotary position or work offset, >= 0
+  double refixture = 15.0;              ///< min: the operator re-clamps the part (setups with manual_refixture), >= 0
+};
+
+/// What the plan search minimises: machine time, money (time x rate + material + tool
+/// wear), or the dimensionless cost_per_mm3 factors and fixed_costs of older machine files.
+enum class Objective { Time, Money, CostFactor };
 
 /// Planner tunables and fixed costs.
 struct Planning {
@@ -234,6 +289,9 @@ struct Planning {
   double tool_change_cost = 0.0;        ///< >= 0
   double setup_change_cost = 0.0;       ///< >= 0
   double mode_switch_cost = 0.0;        ///< AM <-> SM, >= 0
+  /// Default: money when the machine file has a `costs` section, else cost-factor (the
+  /// dimensionless factors older machine files give).
+  Objective objective = Objective::CostFactor;
 };
 
 enum class TransportKind { ModbusTcp, ModbusRtu, SocketCan, Socketcand };
@@ -289,6 +347,7 @@ struct Machine {
   std::vector<Setup> setups;            ///< at least one
   std::vector<RawStock> raw_stocks = {RawStock{.name = "box"}};  ///< default: one box, margin 1 mm
   Planning planning;
+  Costs costs;
   std::vector<Transport> transports;    ///< in file order
   GcodeSettings gcode;
 
@@ -367,6 +426,9 @@ constexpr std::string_view to_string(Approach a) {
     case Approach::MinusZ: return "-Z";
   }
   return "?";
+}
+constexpr std::string_view to_string(Objective o) {
+  return o == Objective::Time ? "time" : o == Objective::Money ? "money" : "cost-factor";
 }
 constexpr std::string_view to_string(Axis a) { return a == Axis::X ? "X" : a == Axis::Y ? "Y" : "Z"; }
 constexpr std::string_view to_string(TransportKind k) {

@@ -18,7 +18,10 @@ constexpr long kMaxTopK = 1000;
 const std::vector<std::pair<std::string_view, Dialect>> kDialects = {{"rs274ngc", Dialect::Rs274ngc},
                                                                     {"fanuc", Dialect::Fanuc}};
 const std::vector<std::string_view> kTopLevelKeys = {"name",  "description", "envelope", "heads", "tools",
-                                                     "setups", "raw_stocks", "planning", "transports", "gcode"};
+                                                     "setups", "raw_stocks", "planning", "costs", "transports",
+                                                     "gcode"};
+const std::vector<std::pair<std::string_view, Objective>> kObjectives = {
+    {"money", Objective::Money}, {"time", Objective::Time}, {"cost-factor", Objective::CostFactor}};
 
 }  // namespace
 
@@ -42,6 +45,11 @@ Machine MachineReader::load(const YAML::Node& root) {
   check_head_tool_numbers();
   if (auto f = r.require("setups")) read_setups(f->value);
   if (auto f = r.find("raw_stocks")) read_raw_stocks(f->value);
+  // A machine file that prices its time plans by money unless it says otherwise.
+  if (auto f = r.find("costs")) {
+    read_costs(f->value);
+    machine_.planning.objective = Objective::Money;
+  }
   if (auto f = r.find("planning")) read_planning(f->value);
   if (auto f = r.find("transports")) read_transports(f->value);
   if (auto f = r.find("gcode")) read_gcode(f->value);
@@ -108,7 +116,7 @@ std::vector<PrimitiveKind> MachineReader::primitives(const Value& v,
 // ------------------------------------------------------------ planning
 
 void MachineReader::read_planning(const Value& v) {
-  MapReader r(sink_, v, {"voxel_size", "tolerance", "sliver_threshold", "top_k", "fixed_costs"});
+  MapReader r(sink_, v, {"voxel_size", "tolerance", "sliver_threshold", "top_k", "objective", "fixed_costs"});
   if (!r.ok()) return;
   Planning& p = machine_.planning;
   number(r, "voxel_size", kLength, Bound::Positive, p.voxel_size);
@@ -117,6 +125,7 @@ void MachineReader::read_planning(const Value& v) {
   if (auto f = r.find("top_k"))
     set(read_integer(sink_, f->value, 1, kMaxTopK, "an integer number of plans from 1 to " + std::to_string(kMaxTopK)),
         p.top_k);
+  if (auto f = r.find("objective")) set(read_enum(sink_, f->value, kObjectives), p.objective);
   if (auto f = r.find("fixed_costs")) {
     MapReader c(sink_, f->value, {"tool_change", "setup_change", "mode_switch"});
     if (c.ok()) {
@@ -125,6 +134,27 @@ void MachineReader::read_planning(const Value& v) {
       number(c, "mode_switch", kCost, Bound::NonNegative, p.mode_switch_cost);
     }
   }
+}
+
+// ------------------------------------------------------------ costs
+
+void MachineReader::read_costs(const Value& v) {
+  MapReader r(sink_, v, {"currency", "machine_rate", "tool_change", "head_switch", "setup_change", "refixture"});
+  if (!r.ok()) return;
+  Costs& c = machine_.costs;
+  if (auto f = r.find("currency")) {
+    const auto text = read_string(sink_, f->value, "a currency label such as EUR or USD");
+    if (text && (text->empty() || text->size() > 8 || text->find_first_of(" \t\r\n") != std::string::npos))
+      sink_.error(f->value.mark, f->value.path + ": expected a short currency label such as EUR or USD, got " +
+                                     describe(f->value.node));
+    else
+      set(text, c.currency);
+  }
+  number(r, "machine_rate", kHourlyRate, Bound::NonNegative, c.machine_rate);
+  number(r, "tool_change", kSeconds, Bound::NonNegative, c.tool_change);
+  number(r, "head_switch", kSeconds, Bound::NonNegative, c.head_switch);
+  number(r, "setup_change", kSeconds, Bound::NonNegative, c.setup_change);
+  number(r, "refixture", kMinutes, Bound::NonNegative, c.refixture);
 }
 
 // ------------------------------------------------------------ transports

@@ -60,6 +60,7 @@ class MachineReader {
   void read_head(const Value& v);
   void read_nozzle(const Value& v, AdditiveHead& head, bool bead_known);
   void read_support(const Value& v, SupportLimits& support);
+  void read_material(const Value& v, DepositMaterial& material);
   void read_deposition_codes(const Value& v, DepositionCodes& codes);
   /// Head tool numbers are unique among heads and never a cutting tool's number.
   void check_head_tool_numbers();
@@ -82,6 +83,7 @@ class MachineReader {
 
   // planning, transports, G-code (machine_reader.cpp)
   void read_planning(const Value& v);
+  void read_costs(const Value& v);
   void read_transports(const Value& v);
   void read_gcode(const Value& v);
   void read_m_codes(const Value& v, MCodes& codes);

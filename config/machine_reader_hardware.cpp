@@ -81,7 +81,7 @@ std::optional<std::size_t> MachineReader::read_heads(const Value& v) {
 void MachineReader::read_head(const Value& v) {
   MapReader r(sink_, v,
               {"name", "process", "bead", "nozzle", "support", "layer_height", "hatch_spacing", "travel_clearance",
-               "feed", "tool_number", "codes", "cost_per_mm3", "primitives"});
+               "feed", "tool_number", "codes", "cost_per_mm3", "deposition_rate", "material", "primitives"});
   if (!r.ok()) return;
   AdditiveHead h;
   if (auto f = r.require("name")) {
@@ -139,9 +139,28 @@ void MachineReader::read_head(const Value& v) {
   }
   head_tool_numbers_.push_back(place);
   number(r, "cost_per_mm3", kCostFactor, Bound::NonNegative, h.cost_per_mm3);
+  number(r, "deposition_rate", kVolumeRate, Bound::Positive, h.deposition_rate);
+  h.material = default_material(h.process);
+  if (auto f = r.find("material")) read_material(f->value, h.material);
   if (auto f = r.find("codes")) read_deposition_codes(f->value, h.codes);
   if (auto f = r.find("primitives")) h.primitives = primitives(f->value, kAdditivePrimitives, h.primitives);
   machine_.heads.push_back(std::move(h));
+}
+
+// What the head's deposit is made of (docs/costs.md): the process's defaults, key by key.
+void MachineReader::read_material(const Value& v, DepositMaterial& m) {
+  MapReader r(sink_, v, {"density", "price_per_kg", "efficiency"});
+  if (!r.ok()) return;
+  number(r, "density", kDensity, Bound::Positive, m.density);
+  number(r, "price_per_kg", kPricePerKg, Bound::NonNegative, m.price_per_kg);
+  if (auto f = r.find("efficiency")) {
+    const auto e = read_number(sink_, f->value, kFraction, Bound::Positive);
+    if (e && *e > 1)
+      sink_.error(f->value.mark, f->value.path + ": expected a fraction of the material fed, 0 < e <= 1, got " +
+                                     describe(f->value.node));
+    else
+      set(e, m.efficiency);
+  }
 }
 
 // The nozzle body: its tip stands `standoff` above the programmed point and must clear the
@@ -251,7 +270,7 @@ std::optional<std::size_t> MachineReader::read_tools(const Value& v) {
 void MachineReader::read_tool(const Value& v) {
   MapReader r(sink_, v,
               {"number", "name", "type", "diameter", "corner_radius", "flute_length", "shank", "holder",
-               "spindle_speed", "feed", "plunge_feed", "step_down", "step_over", "cost_per_mm3", "primitives"});
+               "spindle_speed", "feed", "plunge_feed", "step_down", "step_over", "cost_per_mm3", "removal_rate", "wear", "primitives"});
   if (!r.ok()) return;
   const std::size_t before = sink_.count();
   CuttingTool t;
@@ -273,6 +292,14 @@ void MachineReader::read_tool(const Value& v) {
   number(r, "plunge_feed", kFeed, Bound::Positive, t.plunge_feed);
   read_steps(r, flute_length.has_value(), diameter, t);
   number(r, "cost_per_mm3", kCostFactor, Bound::NonNegative, t.cost_per_mm3);
+  number(r, "removal_rate", kVolumeRate, Bound::Positive, t.removal_rate);
+  if (auto f = r.find("wear")) {
+    MapReader w(sink_, f->value, {"price", "life"});
+    if (w.ok()) {
+      number(w, "price", kMoney, Bound::NonNegative, t.tool_price);
+      number(w, "life", kMinutes, Bound::Positive, t.tool_life);
+    }
+  }
   if (auto f = r.find("primitives")) t.primitives = primitives(f->value, kSubtractivePrimitives, t.primitives);
 
   // The assembly must fit under the spindle with the Z axis fully retracted.

@@ -1,5 +1,7 @@
 // The work-holding sections: setups (approach, work offset and origin, rotary positions
-// against the axes' ranges) and raw stocks (a box with margins or a round bar).
+// against the axes' ranges) and raw stocks (a box with margins, a round bar or a plate).
+
+#include <algorithm>
 
 #include "config/machine_reader.hpp"
 
@@ -108,7 +110,7 @@ void MachineReader::read_raw_stocks(const Value& v) {
 }
 
 void MachineReader::read_raw_stock(const Value& v) {
-  MapReader r(sink_, v, {"name", "box", "round_bar"});
+  MapReader r(sink_, v, {"name", "box", "round_bar", "plate", "density", "price_per_kg"});
   if (!r.ok()) return;
   RawStock stock;
   if (auto f = r.require("name")) {
@@ -117,11 +119,26 @@ void MachineReader::read_raw_stock(const Value& v) {
   }
   const auto* box = r.find("box");
   const auto* bar = r.find("round_bar");
-  if (!box && !bar) {
-    sink_.error(v.mark, v.path + ": missing the stock's shape; expected exactly one of 'box' or 'round_bar'");
-  } else if (box && bar) {
-    const auto& second = box->key_mark.line > bar->key_mark.line ? *box : *bar;
-    sink_.error(second.key_mark, v.path + ": expected exactly one of 'box' or 'round_bar', got both");
+  const auto* plate = r.find("plate");
+  std::vector<const MapReader::Field*> shapes;
+  for (const auto* f : {box, bar, plate})
+    if (f) shapes.push_back(f);
+  std::sort(shapes.begin(), shapes.end(), [](const auto* a, const auto* b) { return a->key_mark.line < b->key_mark.line; });
+  if (shapes.empty()) {
+    sink_.error(v.mark, v.path + ": missing the stock's shape; expected exactly one of 'box', 'round_bar' or 'plate'");
+  } else if (shapes.size() > 1) {
+    sink_.error(shapes[1]->key_mark, v.path + ": expected exactly one of 'box', 'round_bar' or 'plate', got " +
+                                         std::to_string(shapes.size()));
+  } else if (plate) {
+    stock.kind = RawStock::Kind::Plate;
+    stock.margin = {0, 0, 0};
+    MapReader b(sink_, plate->value, {"thickness", "margin"});
+    if (b.ok()) {
+      required_length(b, "thickness", stock.plate_thickness);
+      double margin = 0;
+      number(b, "margin", kLength, Bound::NonNegative, margin);
+      stock.margin = {margin, margin, 0};
+    }
   } else if (box) {
     stock.kind = RawStock::Kind::Box;
     MapReader b(sink_, box->value, {"margin"});
@@ -136,6 +153,8 @@ void MachineReader::read_raw_stock(const Value& v) {
       if (auto a = b.find("axis")) set(read_enum(sink_, a->value, kAxes), stock.bar_axis);
     }
   }
+  number(r, "density", kDensity, Bound::Positive, stock.density);
+  number(r, "price_per_kg", kPricePerKg, Bound::NonNegative, stock.price_per_kg);
   machine_.raw_stocks.push_back(std::move(stock));
 }
 

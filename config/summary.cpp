@@ -56,7 +56,7 @@ std::string summarize(const Machine& m) {
     std::string text = "T" + std::to_string(h.tool_number) + ", " + std::string(to_string(h.process)) + ", bead " +
                        std::string(to_string(h.bead.shape)) + " " + fmt(h.bead.width) + " x " + fmt(h.bead.height) +
                        " mm, layer " + fmt(h.layer_height) + " mm, hatch " + fmt(h.hatch_spacing) + " mm, feed " +
-                       fmt(h.feed) + " mm/min, " + primitives(h.primitives);
+                       fmt(h.feed) + " mm/min, " + fmt(h.volume_rate()) + " mm³/min, " + primitives(h.primitives);
     text += ", overhang <= " + fmt(h.support.max_overhang) + " deg, " +
             (h.support.max_bridge > 0 ? "bridges <= " + fmt(h.support.max_bridge) + " mm" : std::string("no bridging"));
     if (h.nozzle)
@@ -71,7 +71,8 @@ std::string summarize(const Machine& m) {
     if (t.type == ToolType::Bull) text += " r" + fmt(t.corner_radius);
     if (t.name != "T" + std::to_string(t.number)) text += " \"" + t.name + "\"";
     text += ", flutes " + fmt(t.flute_length) + " mm, stick-out " + fmt(t.stick_out()) + " mm, " +
-            fmt(t.spindle_speed) + " rpm, feed " + fmt(t.feed) + " mm/min, " + primitives(t.primitives);
+            fmt(t.spindle_speed) + " rpm, feed " + fmt(t.feed) + " mm/min, " + fmt(t.volume_rate()) + " mm³/min, " +
+            primitives(t.primitives);
     out.item("T" + std::to_string(t.number), text);
   }
 
@@ -89,6 +90,9 @@ std::string summarize(const Machine& m) {
     if (r.kind == RawStock::Kind::Box)
       out.item(r.name, "box, margin " + fmt(r.margin[0]) + " x " + fmt(r.margin[1]) + " x " + fmt(r.margin[2]) +
                               " mm around the part");
+    else if (r.kind == RawStock::Kind::Plate)
+      out.item(r.name, "plate " + fmt(r.plate_thickness) + " mm thick under the part, margin " + fmt(r.margin[0]) +
+                              " mm on X and Y");
     else
       out.item(r.name, "round bar ø" + fmt(r.bar_diameter) + " x " + fmt(r.bar_length) + " mm along " +
                               std::string(to_string(r.bar_axis)));
@@ -103,7 +107,12 @@ std::string summarize(const Machine& m) {
                           ", program end " + m.gcode.m_codes.program_end);
   const Planning& p = m.planning;
   out.row("planning", "voxel " + fmt(p.voxel_size) + " mm, tolerance " + fmt(p.tolerance) + " mm, sliver " +
-                             fmt(p.sliver_threshold) + " mm³, top " + std::to_string(p.top_k) + " plans");
+                             fmt(p.sliver_threshold) + " mm³, top " + std::to_string(p.top_k) + " plans, by " +
+                             std::string(to_string(p.objective)));
+  const Costs& c = m.costs;
+  out.row("costs", fmt(c.machine_rate) + " " + c.currency + "/h, tool change " + fmt(c.tool_change) + " s, head switch " +
+                          fmt(c.head_switch) + " s, setup change " + fmt(c.setup_change) + " s, refixture " +
+                          fmt(c.refixture) + " min");
   return out.text;
 }
 

@@ -64,6 +64,14 @@ inline constexpr Quantity kVolume{"volume", "mm³"};
 inline constexpr Quantity kCost{"cost", "cost units"};
 inline constexpr Quantity kCostFactor{"cost factor", "cost units per mm³"};
 inline constexpr Quantity kPower{"power value", "the controller's power unit"};
+inline constexpr Quantity kMoney{"amount", "money"};
+inline constexpr Quantity kHourlyRate{"rate", "money per hour"};
+inline constexpr Quantity kVolumeRate{"rate", "mm³/min"};
+inline constexpr Quantity kSeconds{"duration", "s"};
+inline constexpr Quantity kMinutes{"duration", "min"};
+inline constexpr Quantity kDensity{"density", "g/cm³"};
+inline constexpr Quantity kPricePerKg{"price", "money per kg"};
+inline constexpr Quantity kFraction{"fraction", "0 < f <= 1"};
 
 enum class Bound { Any, Positive, NonNegative };
 

@@ -1,5 +1,6 @@
 #include "planner/machine_primitives.hpp"
 
+#include <array>
 #include <deque>
 
 #include "geometry/shapes.hpp"
@@ -57,6 +58,22 @@ std::size_t machine_primitive_count(const config::Machine& m) {
   return total;
 }
 
+geometry::Box3 stock_bounds(const config::RawStock& s, const geometry::Box3& d) {
+  const std::array<double, 3>& m = s.margin;
+  switch (s.kind) {
+    case config::RawStock::Kind::Box:
+      return {{d.min.x - m[0], d.min.y - m[1], d.min.z - m[2]}, {d.max.x + m[0], d.max.y + m[1], d.max.z + m[2]}};
+    case config::RawStock::Kind::Plate:
+      return {{d.min.x - m[0], d.min.y - m[1], d.min.z}, {d.max.x + m[0], d.max.y + m[1], d.min.z + s.plate_thickness}};
+    case config::RawStock::Kind::RoundBar: break;
+  }
+  const geometry::Vec3 c{(d.min.x + d.max.x) / 2, (d.min.y + d.max.y) / 2, (d.min.z + d.max.z) / 2};
+  const double r = s.bar_diameter / 2, l = s.bar_length / 2;
+  const geometry::Vec3 half{s.bar_axis == config::Axis::X ? l : r, s.bar_axis == config::Axis::Y ? l : r,
+                            s.bar_axis == config::Axis::Z ? l : r};
+  return {{c.x - half.x, c.y - half.y, c.z - half.z}, {c.x + half.x, c.y + half.y, c.z + half.z}};
+}
+
 std::vector<Primitive> machine_primitives(const config::Machine& m, const Solid& design,
                                           const geometry::IndexBox& domain, const PrimitiveProgress& progress,
                                           const Solid* present) {
@@ -77,12 +94,9 @@ std::vector<Primitive> machine_primitives(const config::Machine& m, const Solid&
     p.mode = Mode::Additive;
     p.capability = stock.name;
     p.cost_per_mm3 = 0;  // material is not costed; removing it is
-    if (stock.kind == config::RawStock::Kind::Box) {
-      p.label = "raw stock " + stock.name + " (box)";
-      add(p, [&] {
-        return geometry::make_box(lattice, {{bb.min.x - stock.margin[0], bb.min.y - stock.margin[1], bb.min.z - stock.margin[2]},
-                                            {bb.max.x + stock.margin[0], bb.max.y + stock.margin[1], bb.max.z + stock.margin[2]}});
-      });
+    if (stock.kind != config::RawStock::Kind::RoundBar) {
+      p.label = "raw stock " + stock.name + (stock.kind == config::RawStock::Kind::Box ? " (box)" : " (plate)");
+      add(p, [&] { return geometry::make_box(lattice, stock_bounds(stock, bb)); });
     } else {
       p.label = "raw stock " + stock.name + " (round bar)";
       add(p, [&] {

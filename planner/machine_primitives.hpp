@@ -40,6 +40,11 @@ Instrument tool_instrument(const config::CuttingTool& tool, config::Approach app
 // Called with a message before each primitive is computed.
 using PrimitiveProgress = std::function<void(std::size_t done, std::size_t total, const std::string& what)>;
 
+// Where a raw stock sits against a design's bounding box (mm): a box grown by its margins,
+// a plate from the design's lowest face up by its thickness and out by its margins on X
+// and Y, a round bar's bounding box (centred on the design's, along its axis).
+geometry::Box3 stock_bounds(const config::RawStock& stock, const geometry::Box3& design);
+
 // How many primitives machine_primitives returns: every raw stock, and every head's and
 // tool's primitive kinds over the setups.
 std::size_t machine_primitive_count(const config::Machine& machine);

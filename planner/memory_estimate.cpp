@@ -28,19 +28,7 @@ Box3 planning_region(const config::Machine& m, const Box3& design, double tolera
   double reach = tolerance;
   for (const auto& head : m.heads) reach = std::max(reach, std::max(head.bead.width, head.bead.height));
   Box3 region = grown(design, reach);
-  const geometry::Vec3 c{(design.min.x + design.max.x) / 2, (design.min.y + design.max.y) / 2,
-                         (design.min.z + design.max.z) / 2};
-  for (const auto& s : m.raw_stocks) {
-    if (s.kind == config::RawStock::Kind::Box) {
-      region = box_hull(region, {{design.min.x - s.margin[0], design.min.y - s.margin[1], design.min.z - s.margin[2]},
-                                 {design.max.x + s.margin[0], design.max.y + s.margin[1], design.max.z + s.margin[2]}});
-    } else {
-      const double r = s.bar_diameter / 2, l = s.bar_length / 2;
-      const geometry::Vec3 half{s.bar_axis == config::Axis::X ? l : r, s.bar_axis == config::Axis::Y ? l : r,
-                                s.bar_axis == config::Axis::Z ? l : r};
-      region = box_hull(region, {{c.x - half.x, c.y - half.y, c.z - half.z}, {c.x + half.x, c.y + half.y, c.z + half.z}});
-    }
-  }
+  for (const auto& s : m.raw_stocks) region = box_hull(region, stock_bounds(s, design));
   return region;
 }
 

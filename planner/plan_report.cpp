@@ -71,6 +71,26 @@ json deviation_json(const Deviation& d) {
 }
 
 // plan.json's `optimality` of the plan at index k (docs/plan-format.md).
+// A cost in the objective's units: "0.2321" (cost factors), "113.2 min", "245.10 EUR".
+std::string cost_text(const PlanningResult& r, double cost) {
+  if (r.objective == config::Objective::Time) return fixed(cost, 1) + " min";
+  if (r.objective == config::Objective::Money) return money_text(cost, r.currency);
+  return fixed(cost, 4);
+}
+
+std::string objective_text(const PlanningResult& r) {
+  switch (r.objective) {
+    case config::Objective::Time: return "time: plans cost their minutes of machine time (docs/costs.md)";
+    case config::Objective::Money:
+      return "money: machine time at its rate, material and tool wear, in " + r.currency + " (docs/costs.md)";
+    case config::Objective::CostFactor: break;
+  }
+  return "cost-factor: the machine file's dimensionless cost_per_mm3 and fixed_costs, over the bounding box's "
+         "volume; estimates from the rates in the costs section or their defaults (docs/costs.md)";
+}
+
+json estimate_json(const Estimate& e) { return {{"minutes", e.minutes}, {"money", e.money}}; }
+
 std::string optimality(const Plan& plan, std::size_t k) {
   if (plan.exact) return k == 0 ? "proven-optimal" : "proven-rank";
   return std::isfinite(plan.gap) ? "gap" : "unknown";
@@ -201,10 +221,13 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
                    {"bounding_box", box_json(r.design.bounding_box_mm())}};
   doc["tolerance"] = r.tolerance;
   doc["sliver_threshold"] = r.sliver_threshold;
+  doc["objective"] = std::string(config::to_string(r.objective));
+  doc["currency"] = r.currency;
   doc["cost_normaliser"] = r.problem.normaliser;
   doc["fixed_costs"] = {{"tool_change", r.problem.fixed.tool_change},
                         {"setup_change", r.problem.fixed.setup_change},
-                        {"mode_switch", r.problem.fixed.mode_switch}};
+                        {"mode_switch", r.problem.fixed.mode_switch},
+                        {"refixture", r.problem.fixed.refixture}};
   doc["max_uses"] = r.problem.max_uses;
 
   json prims = json::array();
@@ -264,21 +287,25 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
   json plans = json::array();
   for (std::size_t k = 0; k < r.plans.size(); ++k) {
     const Plan& plan = r.plans[k];
+    const PlanEstimate estimate = k < r.estimates.size() ? r.estimates[k] : PlanEstimate{};
     json actions = json::array();
     for (std::size_t s = 0; s < plan.steps.size(); ++s) {
       const PlanStep& step = plan.steps[s];
       const Primitive& prim = r.primitives[std::size_t(step.primitive)];
+      const Estimate e = s < estimate.steps.size() ? estimate.steps[s] : Estimate{};
       actions.push_back({{"step", s + 1},
                          {"primitive", prim.name},
                          {"mode", mode_name(prim.mode)},
                          {"volume", step.volume},
                          {"cost", step.cost},
+                         {"estimate", estimate_json(e)},
                          {"region_atoms", atom_ids(step_region(r, plan, s), r.atoms.atom_count())}});
     }
     const Deviation& d = r.deviations[k];
     plans.push_back({{"rank", k + 1},
                      {"expression", expression(r.problem, plan)},
                      {"cost", plan.cost},
+                     {"estimate", estimate_json(estimate.total)},
                      {"optimality", optimality(plan, k)},
                      {"gap", std::isfinite(plan.gap) ? json(plan.gap) : json(nullptr)},
                      {"file", "plans/plan-" + std::to_string(k + 1) + ".vdb"},
@@ -344,6 +371,7 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
   os << "design      " << src.part_path << ": " << fixed(r.design_volume, 1) << " mm\u00B3, " << (b.hi.x - b.lo.x) << " x "
      << (b.hi.y - b.lo.y) << " x " << (b.hi.z - b.lo.z) << " voxels of " << r.lattice.voxel_size << " mm\n";
   os << "machine     " << src.machine_name << " (" << src.machine_path << "), tolerance " << r.tolerance << " mm\n";
+  os << "objective   " << objective_text(r) << "\n";
   os << "primitives  " << r.primitives.size() << "\n";
   for (const Primitive& p : r.primitives) {
     char line[256];
@@ -379,15 +407,21 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
     for (std::size_t k = 0; k < r.plans.size(); ++k) {
       const Plan& plan = r.plans[k];
       const Deviation& d = r.deviations[k];
-      os << "  " << (k + 1) << ". " << expression(r.problem, plan) << "  cost " << fixed(plan.cost, 4) << ", "
+      const PlanEstimate estimate = k < r.estimates.size() ? r.estimates[k] : PlanEstimate{};
+      os << "  " << (k + 1) << ". " << expression(r.problem, plan) << "  cost " << cost_text(r, plan.cost) << ", "
          << optimality_text(plan, k) << "\n";
+      os << "     estimate: " << duration_text(estimate.total.minutes) << " of machine time, "
+         << money_text(estimate.total.money, r.currency) << "\n";
       os << "     deviation: " << deviation_text(d, r.tolerance) << "\n";
       for (std::size_t s = 0; s < plan.steps.size(); ++s) {
         const PlanStep& st = plan.steps[s];
         const Primitive& p = r.primitives[std::size_t(st.primitive)];
-        char line[256];
-        std::snprintf(line, sizeof line, "     %zu) %-4s %-58s %s %10.1f mm\u00B3  cost %.4f\n", s + 1, p.name.c_str(),
-                      p.label.c_str(), p.mode == Mode::Additive ? "deposit" : "remove ", st.volume, st.cost);
+        const Estimate e = s < estimate.steps.size() ? estimate.steps[s] : Estimate{};
+        char line[320];
+        std::snprintf(line, sizeof line, "     %zu) %-4s %-58s %s %10.1f mm\u00B3  cost %s  (%s, %s)\n", s + 1,
+                      p.name.c_str(), p.label.c_str(), p.mode == Mode::Additive ? "deposit" : "remove ", st.volume,
+                      cost_text(r, st.cost).c_str(), duration_text(e.minutes).c_str(),
+                      money_text(e.money, r.currency).c_str());
         os << line;
       }
     }

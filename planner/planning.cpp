@@ -113,6 +113,8 @@ void add_primitives(const config::Machine& machine, const PlanningOptions& optio
       present);
   r.primitives.insert(r.primitives.begin(), std::make_move_iterator(stocks.begin()), std::make_move_iterator(stocks.end()));
   for (std::size_t i = 0; i < r.primitives.size(); ++i) r.primitives[i].name = "P" + std::to_string(i + 1);
+  // In the objective's units before the bands weigh milling against depositing.
+  for (Primitive& p : r.primitives) p.cost_per_mm3 = objective_per_mm3(machine, r.objective, p);
   if (options.bands) {
     for (Primitive& p : banded_primitives(machine, r.design, r.tolerance, r.domain, r.primitives))
       r.primitives.push_back(std::move(p));
@@ -199,12 +201,13 @@ std::shared_ptr<const DepositFooting> first_layer_carriers(const PlanningResult&
 // The symbolic problem the search runs on: atoms with volumes and classes, primitives as
 // sets of atoms, deposits with what the plan's state may rule out.
 PlanningProblem symbolic_problem(const PlanningResult& r, const config::Machine& machine, int max_uses) {
-  const config::Planning& defaults = machine.planning;
   std::map<std::pair<int, int>, std::shared_ptr<const std::vector<AtomSet>>> reach_cache;
   PlanningProblem p;
-  p.normaliser = r.bounding_box_volume > 0 ? r.bounding_box_volume : 1.0;
+  // Cost factors are normalised so that parts compare; minutes and money are read as such.
+  const bool factors = r.objective == config::Objective::CostFactor;
+  p.normaliser = factors && r.bounding_box_volume > 0 ? r.bounding_box_volume : 1.0;
   p.max_uses = max_uses;
-  p.fixed = {defaults.tool_change_cost, defaults.setup_change_cost, defaults.mode_switch_cost};
+  p.fixed = objective_fixed_costs(machine, r.objective);
   for (const AtomMeasures& m : r.measures) {
     AtomSpec a;
     a.volume = m.volume;
@@ -221,6 +224,7 @@ PlanningProblem symbolic_problem(const PlanningResult& r, const config::Machine&
     s.cost_per_mm3 = prim.cost_per_mm3;
     s.tool = prim.capability;
     s.setup = prim.setup;
+    s.refixture = refixture_setup(machine, prim);
     s.blocked_by = reach_limits(r, machine, prim, reach_cache);
     s.footing = first_layer_carriers(r, machine, prim, p.atoms);
     s.atoms = AtomSet(r.atoms.atom_count());
@@ -351,6 +355,8 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
   r.tolerance = options.tolerance >= 0 ? options.tolerance : defaults.tolerance;
   r.sliver_threshold = options.sliver_threshold >= 0 ? options.sliver_threshold : defaults.sliver_threshold;
   const int top_k = options.top_k > 0 ? options.top_k : defaults.top_k;
+  r.objective = options.objective.value_or(defaults.objective);
+  r.currency = machine.costs.currency;
 
   // Before anything large is allocated: a grid over the budget is an input error.
   check_planning_memory(geometry::bounds(part), machine, h, r.tolerance, options.memory_budget, part_name);
@@ -372,8 +378,10 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
     r.timings.back().second = std::max(0.0, r.timings.back().second - validation_seconds);
     r.timings.emplace_back("validate", validation_seconds);
   }
-  for (const Plan& plan : r.plans)
+  for (const Plan& plan : r.plans) {
     r.deviations.push_back(measure_deviation(plan_outcome(r, plan), r.design, r.domain, r.tolerance));
+    r.estimates.push_back(estimate_plan(machine, r.primitives, plan));
+  }
   clock.lap("deviation");
   return r;
 }

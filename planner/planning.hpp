@@ -3,6 +3,7 @@
 // primitives (and any given as files), decompose into atoms, check, search.
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include "geometry/mesh.hpp"
 #include "planner/atoms.hpp"
 #include "planner/check.hpp"
+#include "planner/costing.hpp"
 #include "planner/deviation.hpp"
 #include "planner/machine_primitives.hpp"
 #include "planner/rejection.hpp"
@@ -41,6 +43,8 @@ struct PlanningOptions {
   std::vector<PrimitiveFile> extra_primitives;
   // Banded primitives (planner/bands.hpp): "mill up to here, deposit from here on".
   bool bands = true;
+  // What the search minimises (planner/costing.hpp); unset: the machine file's.
+  std::optional<config::Objective> objective;
   // Raw stocks as files (STL or .vdb on the plan's grid) in the part's frame: a casting, a
   // blank, a worn part to repair. When given, they replace the machine file's raw stocks.
   std::vector<std::string> stock_files;
@@ -81,6 +85,11 @@ struct PlanningResult {
   std::vector<RejectedPlan> rejected;  // candidates validation turned down, in the order found
   bool validated = false;              // the plans were validated (PlanningOptions::validate)
   SearchStats search;
+  // What the plans' costs are in (minutes, money or cost factors), and each plan's
+  // estimate in minutes and money whatever the objective, with the machine's currency.
+  config::Objective objective = config::Objective::CostFactor;
+  std::vector<PlanEstimate> estimates;  // one per plan
+  std::string currency;
   std::vector<std::pair<std::string, double>> timings;  // phase, seconds
 };
 

@@ -89,7 +89,7 @@ double fixed_cost(const PlanningProblem& p, int previous, int next) {
   const PrimitiveSpec& b = p.primitives[std::size_t(next)];
   double c = 0;
   if (a.tool != b.tool) c += p.fixed.tool_change;
-  if (a.setup != b.setup) c += p.fixed.setup_change;
+  if (a.setup != b.setup) c += a.refixture || b.refixture ? p.fixed.refixture : p.fixed.setup_change;
   if (a.mode != b.mode) c += p.fixed.mode_switch;
   return c;
 }

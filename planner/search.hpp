@@ -40,6 +40,9 @@ struct PrimitiveSpec {
   AtomSet atoms;          // the atoms inside the primitive
   std::string tool;       // tool or head identity, for tool-change costs
   std::string setup;      // setup name, for setup-change costs
+  // The part is re-clamped by hand for this setup: a change into or out of it costs
+  // FixedCosts::refixture instead of setup_change.
+  bool refixture = false;
   // Additive only: for each atom, the atoms that, present, put part of it out of the head's
   // reach (planner/deposit_reach.hpp). The action cannot be taken in a state that holds one
   // of them over an atom it would deposit. Null: nothing limits it.
@@ -49,10 +52,14 @@ struct PrimitiveSpec {
   std::shared_ptr<const DepositFooting> footing;
 };
 
+// What changing between two consecutive actions costs (in the problem's cost units, before
+// the normaliser): another tool or head, another setup (refixture when the operator
+// re-clamps the part for one of the two setups), the other mode (milling <-> deposition).
 struct FixedCosts {
   double tool_change = 0;
   double setup_change = 0;
   double mode_switch = 0;
+  double refixture = 0;
 };
 
 struct PlanningProblem {

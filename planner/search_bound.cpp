@@ -63,6 +63,15 @@ LowerBound::LowerBound(const PlanningProblem& p)
     for (std::size_t w = 0; w < words && prim.mode == Mode::Additive; ++w) dirty = dirty || (prim.atoms.words()[w] & must_out_[w]);
     dirty_.push_back(dirty);
   }
+  // The least a change into each setup costs: a refixture when the part is re-clamped for
+  // it, else a setup change, or a refixture when coming from a setup that is re-clamped.
+  bool any_refixture = false;
+  for (const PrimitiveSpec& prim : p.primitives) any_refixture = any_refixture || prim.refixture;
+  setup_entry_.assign(setup_id_.size() + 1, 0);
+  for (std::size_t i = 0; i < p.primitives.size(); ++i)
+    setup_entry_[std::size_t(setup_id_[i])] =
+        p.primitives[i].refixture ? p.fixed.refixture
+                                  : (any_refixture ? std::min(p.fixed.setup_change, p.fixed.refixture) : p.fixed.setup_change);
   auto by_cost = [&](int x, int y) {
     return p.primitives[std::size_t(x)].cost_per_mm3 < p.primitives[std::size_t(y)].cost_per_mm3;
   };
@@ -135,7 +144,7 @@ double LowerBound::side_effects(const AtomSet& state, const Rates& r) const {
 
 double LowerBound::fixed_part(const AtomSet& state, const std::vector<std::uint8_t>& uses, int last) const {
   const FixedCosts& f = p_.fixed;
-  if (f.mode_switch == 0 && f.tool_change == 0 && f.setup_change == 0) return 0;
+  if (f.mode_switch == 0 && f.tool_change == 0 && f.setup_change == 0 && f.refixture == 0) return 0;
   const bool first = last < 0;
   const auto& s = state.words();
   auto allowed = [&](int i) { return uses[std::size_t(i)] < p_.max_uses && (first || !p_.primitives[std::size_t(i)].raw_stock); };
@@ -181,8 +190,15 @@ double LowerBound::fixed_part(const AtomSet& state, const std::vector<std::uint8
     return first ? std::max(0, n - 1) : n;
   };
   const int tools = changes(tool_forced, first ? -1 : tool_id_[std::size_t(last)]);
-  const int setups = changes(setup_forced, first ? -1 : setup_id_[std::size_t(last)]);
-  return f.mode_switch * switches + f.tool_change * tools + f.setup_change * setups;
+  // Each forced setup other than the current one is entered at least once, at no less than
+  // its entry cost; at the start the dearest entry comes free (the first action's setup
+  // is one of them, or none is forced).
+  const int current = first ? -1 : setup_id_[std::size_t(last)];
+  double setups = 0, dearest = 0;
+  for (std::size_t t = 0; t < setup_forced.size(); ++t)
+    if (setup_forced[t] && int(t) != current) setups += setup_entry_[t], dearest = std::max(dearest, setup_entry_[t]);
+  if (first) setups -= dearest;
+  return f.mode_switch * switches + f.tool_change * tools + setups;
 }
 
 double LowerBound::quick(const AtomSet& state, const std::vector<std::uint8_t>& uses, int last) const {

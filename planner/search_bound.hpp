@@ -12,7 +12,8 @@
 //  - fixed costs: a mode switch when the other mode is still needed (two when every
 //    additive primitive left holds a must-out atom and the plan is removing now), a tool
 //    change per tool that some atom can only be changed by, other than the current one,
-//    and likewise per setup.
+//    and likewise per setup (at the least a change into that setup costs: a refixture
+//    when the part is re-clamped for it).
 // The bound is consistent (it never falls by more than an action costs), which the
 // search's duplicate detection relies on; tests/planner/search_bound_test.cpp checks both
 // properties against the exhaustive enumerator.
@@ -50,6 +51,7 @@ class LowerBound {
   std::vector<std::uint64_t> must_in_, must_out_;  // masks
   std::vector<std::vector<int>> adders_, removers_;  // per atom, cheapest first
   std::vector<int> tool_id_, setup_id_;               // per primitive
+  std::vector<double> setup_entry_;                   // per setup id: the least a change into it costs
   std::vector<bool> dirty_;  // an additive primitive holding a must-out atom
 };
 

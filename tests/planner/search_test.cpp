@@ -239,10 +239,12 @@ TEST(Search, OneOrderPerBlockFindsTheOptimumAndTheCheapestPlansInBlockOrder) {
   for (int trial = 0; trial < 200; ++trial) {
     const int n = 2 + trial % 7;  // 2..8 primitives
     VoxelProblem vp = random_instance(rng, n);
-    vp.problem.fixed = {trial % 3 == 0 ? 5.0 : 0.0, trial % 5 == 0 ? 3.0 : 0.0, trial % 4 == 0 ? 7.0 : 0.0};
+    vp.problem.fixed = {trial % 3 == 0 ? 5.0 : 0.0, trial % 5 == 0 ? 3.0 : 0.0, trial % 4 == 0 ? 7.0 : 0.0,
+                        trial % 6 == 0 ? 11.0 : 0.0};
     for (auto& p : vp.problem.primitives) {
       p.tool = "T" + std::to_string(rng() % 2);
       p.setup = rng() % 3 == 0 ? "side" : "top";
+      p.refixture = trial % 2 == 0 && p.setup == "side";  // the part re-clamped by hand for it
     }
     const auto oracle = enumerate_plans(vp.problem);
     std::vector<Plan> ordered;
@@ -414,10 +416,11 @@ TEST(Search, TheLowerBoundNeverOverestimatesAndFallsByAtMostAStepsCost) {
     VoxelProblem vp = random_instance(rng, 2 + trial % 5);
     // With a tolerance band there are free atoms, whose side effects the bound counts.
     vp = make_problem(vp.primitives, vp.design, vp.domain, trial % 2 ? 1.0 : 0.0);
-    vp.problem.fixed = {trial % 3 ? 5.0 : 0.0, trial % 4 ? 3.0 : 0.0, trial % 5 ? 7.0 : 0.0};
+    vp.problem.fixed = {trial % 3 ? 5.0 : 0.0, trial % 4 ? 3.0 : 0.0, trial % 5 ? 7.0 : 0.0, trial % 6 ? 13.0 : 1.0};
     for (auto& p : vp.problem.primitives) {
       p.tool = "T" + std::to_string(rng() % 3);
-      p.setup = rng() % 2 ? "side" : "top";
+      p.setup = rng() % 3 == 0 ? "bottom" : rng() % 2 ? "side" : "top";
+      p.refixture = trial % 2 == 0 && p.setup == "bottom";  // the part turned over by hand
     }
     const LowerBound bound(vp.problem);
     for (const Plan& plan : enumerate_plans(vp.problem, 200)) {
