@@ -176,7 +176,7 @@ int run_dry_run(const DryRunArgs& a) {
   planner::PlanningOptions options;
   options.voxel_size = a.voxel;
   options.memory_budget = memory_budget(a.memory_budget);
-  options.validate = validation::plan_validator(machine);
+  validation::use_validation(options, machine);
   options.stock_files = a.stock_files;
   options.objective = objective(a.objective);
   const planner::PlanningResult planned = planner::plan_part(geometry::read_stl(a.part), a.part, machine, options);

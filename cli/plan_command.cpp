@@ -62,7 +62,7 @@ int run_plan(const PlanArgs& args) {
   for (const std::string& p : args.primitive_files) options.extra_primitives.push_back(parse_primitive_argument(p));
   options.stock_files = args.stock_files;
   // Every plan offered is proven by execution first (validation/, docs/validation.md).
-  if (!args.no_validate) options.validate = validation::plan_validator(machine);
+  if (!args.no_validate) validation::use_validation(options, machine);
   options.bands = !args.no_bands;
   options.objective = objective(args.objective);
   options.max_rejected = args.max_rejected;

@@ -67,8 +67,10 @@ PlanEstimate estimate_plan(const config::Machine& m, const std::vector<Primitive
     const Primitive& p = primitives[std::size_t(step.primitive)];
     const Estimate rate = per_mm3(m, p);
     Estimate s{rate.minutes * step.volume, rate.money * step.volume};
-    if (previous) s += change_between(m, *previous, p);
+    const Estimate change = previous ? change_between(m, *previous, p) : Estimate{};
+    s += change;
     e.steps.push_back(s);
+    e.changes.push_back(change);
     e.total += s;
     previous = &p;
   }

@@ -40,7 +40,8 @@ Estimate change_between(const config::Machine& machine, const Primitive& from, c
 
 // A plan's steps, each with its change from the step before, and their sum.
 struct PlanEstimate {
-  std::vector<Estimate> steps;
+  std::vector<Estimate> steps;    // each with the change before it
+  std::vector<Estimate> changes;  // that change alone
   Estimate total;
 };
 PlanEstimate estimate_plan(const config::Machine& machine, const std::vector<Primitive>& primitives, const Plan& plan);

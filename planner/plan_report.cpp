@@ -89,6 +89,19 @@ std::string objective_text(const PlanningResult& r) {
          "volume; estimates from the rates in the costs section or their defaults (docs/costs.md)";
 }
 
+// A plan's toolpath minutes with the changes between actions as the estimate has them;
+// null when not known.
+json toolpath_total(const PlanningResult& r, std::size_t k) {
+  if (k >= r.toolpath_minutes.size() || r.toolpath_minutes[k].empty() || k >= r.estimates.size()) return nullptr;
+  double total = 0;
+  for (double m : r.toolpath_minutes[k]) total += m;
+  for (const Estimate& change : r.estimates[k].changes) total += change.minutes;
+  return total;
+}
+
+// A plan's rank in the search's order (0 = first): its place unless the toolpaths re-ranked.
+std::size_t search_rank(const PlanningResult& r, std::size_t k) { return k < r.search_rank.size() ? r.search_rank[k] : k; }
+
 json estimate_json(const Estimate& e) { return {{"minutes", e.minutes}, {"money", e.money}}; }
 
 std::string optimality(const Plan& plan, std::size_t k) {
@@ -204,6 +217,50 @@ std::string primitive_capability(const Primitive& p, const std::filesystem::path
   return p.kind == PrimitiveKind::File || p.from_file ? path_from_plan_directory(p.capability, directory) : p.capability;
 }
 
+namespace {
+
+// The offered plans, best first, each with its actions.
+json plans_json(const PlanningResult& r) {
+  json plans = json::array();
+  for (std::size_t k = 0; k < r.plans.size(); ++k) {
+    const Plan& plan = r.plans[k];
+    const PlanEstimate estimate = k < r.estimates.size() ? r.estimates[k] : PlanEstimate{};
+    json actions = json::array();
+    for (std::size_t s = 0; s < plan.steps.size(); ++s) {
+      const PlanStep& step = plan.steps[s];
+      const Primitive& prim = r.primitives[std::size_t(step.primitive)];
+      const Estimate e = s < estimate.steps.size() ? estimate.steps[s] : Estimate{};
+      actions.push_back({{"step", s + 1},
+                         {"primitive", prim.name},
+                         {"mode", mode_name(prim.mode)},
+                         {"volume", step.volume},
+                         {"cost", step.cost},
+                         {"estimate", estimate_json(e)},
+                         {"toolpath_minutes", k < r.toolpath_minutes.size() && s < r.toolpath_minutes[k].size()
+                                                  ? json(r.toolpath_minutes[k][s])
+                                                  : json(nullptr)},
+                         {"region_atoms", atom_ids(step_region(r, plan, s), r.atoms.atom_count())}});
+    }
+    const Deviation& d = r.deviations[k];
+    plans.push_back({{"rank", k + 1},
+                     {"expression", expression(r.problem, plan)},
+                     {"cost", plan.cost},
+                     {"estimate", estimate_json(estimate.total)},
+                     {"toolpath_minutes", toolpath_total(r, k)},
+                     {"optimality", optimality(plan, search_rank(r, k))},
+                     {"search_rank", search_rank(r, k) + 1},
+                     {"toolpath_cost", k < r.toolpath_costs.size() ? json(r.toolpath_costs[k]) : json(nullptr)},
+                     {"gap", std::isfinite(plan.gap) ? json(plan.gap) : json(nullptr)},
+                     {"file", "plans/plan-" + std::to_string(k + 1) + ".vdb"},
+                     {"final_atoms", atom_ids(plan.final_state, r.atoms.atom_count())},
+                     {"deviation", deviation_json(d)},
+                     {"actions", actions}});
+  }
+  return plans;
+}
+
+}  // namespace
+
 std::string plan_json(const PlanningResult& r, const ReportSources& src, const std::filesystem::path& directory) {
   json doc;
   doc["format"] = "hybridctl-plan";
@@ -284,36 +341,9 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
                    {"lower_bound", r.search.lower_bound},
                    {"seconds", r.search.seconds}};
 
-  json plans = json::array();
-  for (std::size_t k = 0; k < r.plans.size(); ++k) {
-    const Plan& plan = r.plans[k];
-    const PlanEstimate estimate = k < r.estimates.size() ? r.estimates[k] : PlanEstimate{};
-    json actions = json::array();
-    for (std::size_t s = 0; s < plan.steps.size(); ++s) {
-      const PlanStep& step = plan.steps[s];
-      const Primitive& prim = r.primitives[std::size_t(step.primitive)];
-      const Estimate e = s < estimate.steps.size() ? estimate.steps[s] : Estimate{};
-      actions.push_back({{"step", s + 1},
-                         {"primitive", prim.name},
-                         {"mode", mode_name(prim.mode)},
-                         {"volume", step.volume},
-                         {"cost", step.cost},
-                         {"estimate", estimate_json(e)},
-                         {"region_atoms", atom_ids(step_region(r, plan, s), r.atoms.atom_count())}});
-    }
-    const Deviation& d = r.deviations[k];
-    plans.push_back({{"rank", k + 1},
-                     {"expression", expression(r.problem, plan)},
-                     {"cost", plan.cost},
-                     {"estimate", estimate_json(estimate.total)},
-                     {"optimality", optimality(plan, k)},
-                     {"gap", std::isfinite(plan.gap) ? json(plan.gap) : json(nullptr)},
-                     {"file", "plans/plan-" + std::to_string(k + 1) + ".vdb"},
-                     {"final_atoms", atom_ids(plan.final_state, r.atoms.atom_count())},
-                     {"deviation", deviation_json(d)},
-                     {"actions", actions}});
-  }
+  const json plans = plans_json(r);
   doc["plans"] = plans;
+  doc["ranked_by_toolpaths"] = r.ranked_by_toolpaths;
   doc["validated"] = r.validated;
   doc["rejected"] = rejected_json(r);
   json timings = json::object();
@@ -404,24 +434,37 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
       os << "; the exact search hit its limit, so plans it did not prove come from weighted A* (w = "
          << r.search.weight << ") with a proven gap against the lower bound " << fixed(r.search.lower_bound, 4);
     os << ")\n";
+    if (r.ranked_by_toolpaths)
+      os << "ranked      by the toolpaths' cycle times: some action's estimate is more than 25 % off its toolpath's "
+            "(docs/costs.md)\n";
     for (std::size_t k = 0; k < r.plans.size(); ++k) {
       const Plan& plan = r.plans[k];
       const Deviation& d = r.deviations[k];
       const PlanEstimate estimate = k < r.estimates.size() ? r.estimates[k] : PlanEstimate{};
       os << "  " << (k + 1) << ". " << expression(r.problem, plan) << "  cost " << cost_text(r, plan.cost) << ", "
-         << optimality_text(plan, k) << "\n";
+         << optimality_text(plan, search_rank(r, k));
+      if (k < r.toolpath_costs.size())
+        os << " by the estimate; " << cost_text(r, r.toolpath_costs[k]) << " with the toolpaths' times";
+      os << "\n";
       os << "     estimate: " << duration_text(estimate.total.minutes) << " of machine time, "
-         << money_text(estimate.total.money, r.currency) << "\n";
+         << money_text(estimate.total.money, r.currency);
+      const json toolpaths = toolpath_total(r, k);
+      if (!toolpaths.is_null()) os << "; toolpaths " << duration_text(toolpaths.get<double>());
+      os << "\n";
       os << "     deviation: " << deviation_text(d, r.tolerance) << "\n";
       for (std::size_t s = 0; s < plan.steps.size(); ++s) {
         const PlanStep& st = plan.steps[s];
         const Primitive& p = r.primitives[std::size_t(st.primitive)];
         const Estimate e = s < estimate.steps.size() ? estimate.steps[s] : Estimate{};
-        char line[320];
-        std::snprintf(line, sizeof line, "     %zu) %-4s %-58s %s %10.1f mm\u00B3  cost %s  (%s, %s)\n", s + 1,
+        std::string toolpath;
+        if (k < r.toolpath_minutes.size() && s < r.toolpath_minutes[k].size() && p.kind != PrimitiveKind::RawStock)
+          toolpath = "; toolpath " + duration_text(r.toolpath_minutes[k][s] +
+                                                   (s < estimate.changes.size() ? estimate.changes[s].minutes : 0.0));
+        char line[360];
+        std::snprintf(line, sizeof line, "     %zu) %-4s %-58s %s %10.1f mm\u00B3  cost %s  (%s, %s%s)\n", s + 1,
                       p.name.c_str(), p.label.c_str(), p.mode == Mode::Additive ? "deposit" : "remove ", st.volume,
                       cost_text(r, st.cost).c_str(), duration_text(e.minutes).c_str(),
-                      money_text(e.money, r.currency).c_str());
+                      money_text(e.money, r.currency).c_str(), toolpath.c_str());
         os << line;
       }
     }

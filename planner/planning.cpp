@@ -1,4 +1,5 @@
 #include "planner/planning.hpp"
+#include "planner/toolpath_rank.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -381,7 +382,9 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
   for (const Plan& plan : r.plans) {
     r.deviations.push_back(measure_deviation(plan_outcome(r, plan), r.design, r.domain, r.tolerance));
     r.estimates.push_back(estimate_plan(machine, r.primitives, plan));
+    if (options.toolpath_minutes) r.toolpath_minutes.push_back(options.toolpath_minutes(plan));
   }
+  rank_by_toolpaths(machine, r);
   clock.lap("deviation");
   return r;
 }

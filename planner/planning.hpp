@@ -58,6 +58,10 @@ struct PlanningOptions {
   // recorded in PlanningResult::rejected and the search goes on to the next candidate,
   // until top_k plans are kept, the plans run out, or `max_rejected` were turned down.
   std::function<std::vector<RejectionReason>(const PlanningResult&, const Plan&)> validate;
+  // After the search: an offered plan's actions' cycle times in minutes from their
+  // toolpaths (validation records them as it proves plans; empty: unknown). Where they
+  // are far from the estimate the plans are ranked by them (planner/toolpath_rank.hpp).
+  std::function<std::vector<double>(const Plan&)> toolpath_minutes;
   std::int64_t max_rejected = 200;
 };
 
@@ -90,6 +94,12 @@ struct PlanningResult {
   config::Objective objective = config::Objective::CostFactor;
   std::vector<PlanEstimate> estimates;  // one per plan
   std::string currency;
+  // Per plan, per action: the toolpath's cycle time in minutes (empty: not known), and
+  // whether the plans were ranked by them because some estimate was far off.
+  std::vector<std::vector<double>> toolpath_minutes;
+  bool ranked_by_toolpaths = false;
+  std::vector<std::size_t> search_rank;  // per plan: its rank (0 = first) in the search's order
+  std::vector<double> toolpath_costs;    // ranked_by_toolpaths: per plan, its cost with the toolpaths' times
   std::vector<std::pair<std::string, double>> timings;  // phase, seconds
 };
 

@@ -6,6 +6,8 @@
 #include <optional>
 
 #include "common/error.hpp"
+#include "gcode/check.hpp"
+#include "gcode/post.hpp"
 #include "planner/plan_report.hpp"
 
 namespace hybridctl::validation {
@@ -16,7 +18,38 @@ planner::PlanFilePlan candidate_plan(const planner::PlanningResult& r, const pla
   return out;
 }
 
-PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions options, std::shared_ptr<PrefixCache> cache) {
+namespace {
+
+// Minutes per action of an execution that ran to its end: each action's own program under
+// the time model of `gcode check`.
+std::vector<double> action_minutes(const Execution& run, const config::Machine& machine) {
+  std::vector<double> minutes;
+  for (const toolpaths::ExportedAction& a : run.exported.actions) {
+    if (!a.makes_gcode) {
+      minutes.push_back(0);
+      continue;
+    }
+    const std::string text = gcode::write_action(a.program, machine);
+    minutes.push_back(gcode::check_program(text, machine, a.primitive).time.total / 60.0);
+  }
+  return minutes;
+}
+
+}  // namespace
+
+void use_validation(planner::PlanningOptions& options, const config::Machine& machine) {
+  auto times = std::make_shared<ToolpathTimes>();
+  options.validate = plan_validator(machine, {}, nullptr, times);
+  options.toolpath_minutes = [times](const planner::Plan& plan) {
+    std::vector<int> key;
+    for (const planner::PlanStep& s : plan.steps) key.push_back(s.primitive);
+    const auto it = times->find(key);
+    return it == times->end() ? std::vector<double>{} : it->second;
+  };
+}
+
+PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions options, std::shared_ptr<PrefixCache> cache,
+                         std::shared_ptr<ToolpathTimes> times) {
   struct State {
     ExecutionOptions options;
     std::optional<planner::PlanFile> file;  // the planning result's grid, design and primitives
@@ -38,7 +71,7 @@ PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions option
   auto state = std::make_shared<State>();
   state->options = std::move(options);
   state->cache = cache ? std::move(cache) : std::make_shared<PrefixCache>();
-  return [&machine, state](const planner::PlanningResult& r, const planner::Plan& plan) {
+  return [&machine, state, times](const planner::PlanningResult& r, const planner::Plan& plan) {
     if (!state->file) {
       // No plans yet: only the grid, the design and the primitives are taken.
       const planner::ReportSources sources{"", "", machine.name, ""};
@@ -61,6 +94,11 @@ PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions option
         std::vector<int> prefix;
         for (int k = 0; k < run.stopped_after; ++k) prefix.push_back(candidate.actions[std::size_t(k)].primitive);
         state->failed_prefixes.push_back({std::move(prefix), run.reasons, run.missing_after_last_addition});
+      }
+      if (times && run.proven() && run.exported.actions.size() == candidate.actions.size()) {
+        std::vector<int> key;
+        for (const planner::PlanFileAction& a : candidate.actions) key.push_back(a.primitive);
+        (*times)[key] = action_minutes(run, machine);
       }
       return std::move(run.reasons);
     } catch (const InputError& e) {

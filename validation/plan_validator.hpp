@@ -9,6 +9,7 @@
 //   // r.plans: proven; r.rejected: the candidates that failed, with their reasons
 
 #include <functional>
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -20,12 +21,21 @@ namespace hybridctl::validation {
 
 using PlanCheck = std::function<std::vector<planner::RejectionReason>(const planner::PlanningResult&, const planner::Plan&)>;
 
+// Per proven candidate (its primitives in order), each action's cycle time in minutes as
+// `gcode check` estimates it from the action's own program (0 for one that makes no G-code).
+using ToolpathTimes = std::map<std::vector<int>, std::vector<double>>;
+
 // The hook. It keeps `machine` by reference (it must outlive planning) and turns the
 // planning result into a plan file (planner::to_plan_file) once, at the first candidate.
 // Candidates resume from the prefixes `cache` holds (one is made when none is given; pass
 // one to read its stats); it must serve this validator alone.
 PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions options = {},
-                         std::shared_ptr<PrefixCache> cache = nullptr);
+                         std::shared_ptr<PrefixCache> cache = nullptr, std::shared_ptr<ToolpathTimes> times = nullptr);
+
+// Validation by execution for `plan_part`: the hook, and the toolpaths' cycle times of the
+// plans it proved (PlanningOptions::toolpath_minutes), which rank the offered plans where
+// the estimate is far off (docs/costs.md).
+void use_validation(planner::PlanningOptions& options, const config::Machine& machine);
 
 // One candidate of a planning result as the plan file names it (rank 0).
 planner::PlanFilePlan candidate_plan(const planner::PlanningResult& result, const planner::Plan& plan);
