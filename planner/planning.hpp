@@ -98,6 +98,7 @@ struct PlanningResult {
   // whether the plans were ranked by them because some estimate was far off.
   std::vector<std::vector<double>> toolpath_minutes;
   bool ranked_by_toolpaths = false;
+  int estimates_off = 0;  // actions whose estimate is more than kEstimateTolerance off their toolpath's time
   std::vector<std::size_t> search_rank;  // per plan: its rank (0 = first) in the search's order
   std::vector<double> toolpath_costs;    // ranked_by_toolpaths: per plan, its cost with the toolpaths' times
   std::vector<std::pair<std::string, double>> timings;  // phase, seconds

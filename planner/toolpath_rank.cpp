@@ -45,10 +45,11 @@ double cost_with_toolpaths(const config::Machine& machine, const PlanningResult&
 }
 
 void rank_by_toolpaths(const config::Machine& machine, PlanningResult& r) {
-  bool off = false;
+  r.estimates_off = 0;
   for (std::size_t k = 0; k < r.plans.size() && k < r.toolpath_minutes.size(); ++k)
     for (std::size_t s = 0; s < r.plans[k].steps.size() && s < r.toolpath_minutes[k].size(); ++s)
-      off = off || estimate_off(estimated_work(machine, r, r.plans[k].steps[s]), r.toolpath_minutes[k][s]);
+      r.estimates_off += estimate_off(estimated_work(machine, r, r.plans[k].steps[s]), r.toolpath_minutes[k][s]);
+  const bool off = r.estimates_off > 0;
   std::vector<std::size_t> order(r.plans.size());
   std::iota(order.begin(), order.end(), 0);
   r.search_rank = order;

@@ -65,6 +65,7 @@ TEST(ToolpathRank, PlansKeepTheSearchsOrderWhileTheEstimatesHold) {
   r.toolpath_minutes = {{1.1}, {11}};
   rank_by_toolpaths(machine(), r);
   EXPECT_FALSE(r.ranked_by_toolpaths);
+  EXPECT_EQ(r.estimates_off, 0);
   EXPECT_EQ(r.plans[0].steps[0].primitive, 1);
   EXPECT_EQ(r.search_rank, (std::vector<std::size_t>{0, 1}));
 }
@@ -75,12 +76,23 @@ TEST(ToolpathRank, AFarOffEstimateRanksThePlansByTheirToolpathsTimes) {
   r.toolpath_minutes = {{30}, {11}};
   rank_by_toolpaths(machine(), r);
   ASSERT_TRUE(r.ranked_by_toolpaths);
+  EXPECT_EQ(r.estimates_off, 1);
   EXPECT_EQ(r.plans[0].steps[0].primitive, 0);
   EXPECT_EQ(r.search_rank, (std::vector<std::size_t>{1, 0}));
   EXPECT_EQ(r.toolpath_minutes[0], std::vector<double>{11});
   EXPECT_DOUBLE_EQ(r.toolpath_costs[0], 11);
   EXPECT_DOUBLE_EQ(r.toolpath_costs[1], 30);
   EXPECT_DOUBLE_EQ(r.estimates[0].total.minutes, 10);  // the estimates travel with their plans
+}
+
+TEST(ToolpathRank, CostFactorsAreNotTimesSoTheirRankingStandsAndTheEstimatesOffAreCounted) {
+  PlanningResult r = two_plans();
+  r.objective = config::Objective::CostFactor;
+  r.toolpath_minutes = {{30}, {11}};
+  rank_by_toolpaths(machine(), r);
+  EXPECT_FALSE(r.ranked_by_toolpaths);
+  EXPECT_EQ(r.estimates_off, 1);
+  EXPECT_EQ(r.plans[0].steps[0].primitive, 1);
 }
 
 TEST(ToolpathRank, InMoneyTheToolpathsTimeIsPricedAtTheMachinesRateAndTheMaterialStays) {
