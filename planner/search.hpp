@@ -113,6 +113,14 @@ struct SearchStats {
 // in such an order are then not listed as different plans.
 enum class BlockOrders { Every, Cheapest };
 
+// Which way the search builds plans (docs/search.md): from the empty state forwards, or
+// from the goal backwards, a primitive put before a partial plan only when it gets no atom
+// wrong that the rest leaves undecided. Auto: backwards when every atom is must-in or
+// must-out and no primitive's reach or footing depends on the material present (blocked_by,
+// footing: forward search knows it step by step, backward search only of whole plans);
+// forwards otherwise.
+enum class SearchDirection { Auto, Forward, Backward };
+
 struct SearchOptions {
   int top_k = 5;
   std::int64_t max_expansions = 5'000'000;
@@ -138,6 +146,11 @@ struct SearchOptions {
   // gap. A budget makes the result depend on the machine's speed; the expansion and state
   // limits do not.
   double time_limit = 0;
+  // Search the problem reduced to the primitives that can take part in a plan, with the
+  // atoms they all treat alike merged (planner/search_reduce.hpp). The same plans at the
+  // same costs; false searches the problem as given, for comparison.
+  bool reduce = true;
+  SearchDirection direction = SearchDirection::Auto;
 };
 
 // The k cheapest distinct accepted plans, cheapest first, by A* with the admissible and

@@ -44,7 +44,7 @@ struct LowerBound::Rates {
 };
 
 LowerBound::LowerBound(const PlanningProblem& p)
-    : p_(p), atoms_(int(p.atoms.size())), tool_id_(ids_of(p, false)), setup_id_(ids_of(p, true)) {
+    : p_(p), closure_(p), atoms_(int(p.atoms.size())), tool_id_(ids_of(p, false)), setup_id_(ids_of(p, true)) {
   const std::size_t words = std::size_t((atoms_ + 63) / 64);
   must_in_.assign(words, 0);
   must_out_.assign(words, 0);
@@ -79,11 +79,15 @@ LowerBound::LowerBound(const PlanningProblem& p)
   for (auto& l : removers_) std::stable_sort(l.begin(), l.end(), by_cost);
 }
 
-LowerBound::Rates LowerBound::rates(const std::vector<std::uint8_t>& uses, bool first) const {
-  Rates r{*this, std::vector<bool>(p_.primitives.size())};
+std::vector<bool> LowerBound::usable(const std::vector<std::uint8_t>& uses, bool first) const {
+  std::vector<bool> candidates(p_.primitives.size());
   for (std::size_t i = 0; i < p_.primitives.size(); ++i)
-    r.allowed[i] = uses[i] < p_.max_uses && (first || !p_.primitives[i].raw_stock);
-  return r;
+    candidates[i] = uses[i] < p_.max_uses && (first || !p_.primitives[i].raw_stock);
+  return closure_.usable(std::move(candidates));
+}
+
+LowerBound::Rates LowerBound::rates(const std::vector<std::uint8_t>& uses, bool first) const {
+  return Rates{*this, usable(uses, first)};
 }
 
 double LowerBound::atom_part(const AtomSet& state, const Rates& r) const {
@@ -142,12 +146,12 @@ double LowerBound::side_effects(const AtomSet& state, const Rates& r) const {
   return add + remove;
 }
 
-double LowerBound::fixed_part(const AtomSet& state, const std::vector<std::uint8_t>& uses, int last) const {
+double LowerBound::fixed_part(const AtomSet& state, const Rates& r, int last) const {
   const FixedCosts& f = p_.fixed;
   if (f.mode_switch == 0 && f.tool_change == 0 && f.setup_change == 0 && f.refixture == 0) return 0;
   const bool first = last < 0;
   const auto& s = state.words();
-  auto allowed = [&](int i) { return uses[std::size_t(i)] < p_.max_uses && (first || !p_.primitives[std::size_t(i)].raw_stock); };
+  auto allowed = [&](int i) { return bool(r.allowed[std::size_t(i)]); };
   bool need_add = false, need_remove = false;
   for (std::size_t w = 0; w < s.size(); ++w) {
     need_add = need_add || (must_in_[w] & ~s[w]);
@@ -205,7 +209,7 @@ double LowerBound::quick(const AtomSet& state, const std::vector<std::uint8_t>& 
   const Rates r = rates(uses, last < 0);
   const double atoms = atom_part(state, r);
   if (atoms == kInfinity) return kInfinity;
-  return (atoms + fixed_part(state, uses, last)) / p_.normaliser;
+  return (atoms + fixed_part(state, r, last)) / p_.normaliser;
 }
 
 double LowerBound::operator()(const AtomSet& state, const std::vector<std::uint8_t>& uses, int last) const {
@@ -214,7 +218,7 @@ double LowerBound::operator()(const AtomSet& state, const std::vector<std::uint8
   if (atoms == kInfinity) return kInfinity;
   const double side = side_effects(state, r);
   if (side == kInfinity) return kInfinity;
-  return (atoms + side + fixed_part(state, uses, last)) / p_.normaliser;
+  return (atoms + side + fixed_part(state, r, last)) / p_.normaliser;
 }
 
 }  // namespace hybridctl::planner

@@ -14,6 +14,9 @@
 //    change per tool that some atom can only be changed by, other than the current one,
 //    and likewise per setup (at the least a change into that setup costs: a refixture
 //    when the part is re-clamped for it).
+// Only primitives some suffix of a plan can hold count as still allowed
+// (planner/search_reduce.hpp: SuffixClosure), which makes every part larger and tells
+// dead ends: a wrong atom none of them can fix.
 // The bound is consistent (it never falls by more than an action costs), which the
 // search's duplicate detection relies on; tests/planner/search_bound_test.cpp checks both
 // properties against the exhaustive enumerator.
@@ -22,6 +25,7 @@
 #include <vector>
 
 #include "planner/search.hpp"
+#include "planner/search_reduce.hpp"
 
 namespace hybridctl::planner {
 
@@ -38,15 +42,20 @@ class LowerBound {
   // Only the atom part and the fixed costs: cheaper, never above operator().
   double quick(const AtomSet& state, const std::vector<std::uint8_t>& uses, int last) const;
 
+  // The primitives a completion may still use: not used up, no raw stock after the first
+  // action, and held by some suffix of a plan reaching the goal.
+  std::vector<bool> usable(const std::vector<std::uint8_t>& uses, bool first) const;
+
  private:
   struct Rates;
   friend struct Rates;
   Rates rates(const std::vector<std::uint8_t>& uses, bool first) const;
   double atom_part(const AtomSet& state, const Rates& r) const;
   double side_effects(const AtomSet& state, const Rates& r) const;
-  double fixed_part(const AtomSet& state, const std::vector<std::uint8_t>& uses, int last) const;
+  double fixed_part(const AtomSet& state, const Rates& r, int last) const;
 
   const PlanningProblem& p_;
+  SuffixClosure closure_;
   int atoms_ = 0;
   std::vector<std::uint64_t> must_in_, must_out_;  // masks
   std::vector<std::vector<int>> adders_, removers_;  // per atom, cheapest first
