@@ -18,6 +18,7 @@
 #include "planner/bands.hpp"
 #include "planner/deposit_reach.hpp"
 #include "planner/memory_estimate.hpp"
+#include "planner/repair_primitives.hpp"
 
 namespace hybridctl::planner {
 namespace {
@@ -119,6 +120,13 @@ void add_primitives(const config::Machine& machine, const PlanningOptions& optio
   if (options.bands) {
     for (Primitive& p : banded_primitives(machine, r.design, r.tolerance, r.domain, r.primitives))
       r.primitives.push_back(std::move(p));
+  }
+  if (stocks.size() == 1) {
+    // A repair: deposits near what the stock lacks, milled back where the head reaches.
+    for (Primitive& p : repair_primitives(machine, r.design, r.primitives.front().region, r.tolerance, r.domain, r.primitives)) {
+      p.name = "P" + std::to_string(r.primitives.size() + 1);
+      r.primitives.push_back(std::move(p));
+    }
   }
   const std::vector<PrimitiveFile>& files = options.extra_primitives;
   for (const PrimitiveFile& f : files) {

@@ -7,6 +7,7 @@
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
 #include "geometry/mesh.hpp"
+#include "geometry/morphology.hpp"
 #include "planner/planning.hpp"
 
 namespace hybridctl::planner {
@@ -47,6 +48,29 @@ TEST(StockFile, ADepositFromAboveBuildsOnTheWornFlangeItCouldNotBuildFromThePlat
   EXPECT_LT(intersect(missing, u_am_top(plate)).volume(), 0.5 * missing.volume());
   // On the worn part the flange is there: all of it does.
   EXPECT_EQ(subtract(missing, u_am_top(worn)).volume(), 0.0);
+}
+
+// A repair: besides the whole-part deposits, each head's deposits cut to the neighbourhood
+// of what the worn part lacks (planner/repair_primitives.hpp), so that the overfill lies
+// where the head and the cutters reach, not all over the part.
+TEST(StockFile, ARepairOffersDepositsCutToTheNeighbourhoodOfWhatTheWornPartLacks) {
+  const PlanningResult worn = plan_hub({kParts + "flanged-hub-worn.stl"}, 1);
+  const geometry::Solid missing = subtract(worn.design, worn.primitives[0].region);
+  const Primitive* whole = nullptr;
+  const Primitive* local = nullptr;
+  for (const Primitive& p : worn.primitives) {
+    if (p.kind != PrimitiveKind::OAm || p.setup != "top") continue;
+    (p.label.find(", near the missing") == std::string::npos ? whole : local) = &p;
+  }
+  ASSERT_NE(whole, nullptr);
+  ASSERT_NE(local, nullptr);
+  EXPECT_EQ(subtract(missing, local->region).volume(), 0.0);  // it makes all that is missing
+  EXPECT_LT(local->region.volume(), 0.5 * whole->region.volume());
+  // Nothing farther from the missing region than the bead's width (1.5 mm) and the tolerance.
+  const geometry::Solid near = dilate(missing, geometry::Ball{2.0 + 1e-9}, worn.domain);
+  EXPECT_EQ(subtract(local->region, near).volume(), 0.0);
+  // Without a stock there is nothing to repair.
+  for (const Primitive& p : plan_hub({}, 1).primitives) EXPECT_EQ(p.label.find(", near the missing"), std::string::npos);
 }
 
 TEST(StockFile, AStockAwayFromThePartIsRefusedSayingWhere) {
