@@ -14,6 +14,7 @@
 #include "planner/atoms.hpp"
 #include "planner/planning.hpp"
 #include "planner/search.hpp"
+#include "planner/search_reduce.hpp"
 #include "bench/baseline_astar.hpp"
 #include "bench/plan_problem.hpp"
 
@@ -104,14 +105,14 @@ planner::PlanningProblem synthetic_problem(int n, std::uint32_t seed) {
 }
 
 // Random instances vary a lot in difficulty: three seeds per size. The baseline stops at
-// 2 million expansions (counter "limit" = 1 then) so the run always ends.
+// the expansion limit of arg 2 (counter "limit" = 1 then) so the run always ends.
 void BM_AStar(benchmark::State& state) {
   const auto p = synthetic_problem(int(state.range(0)), std::uint32_t(state.range(1)));
   planner::SearchStats stats;
   std::size_t found = 0;
   double cost = 0;
   for (auto _ : state) {
-    const auto plans = planner::baseline::find_plans(p, {1, 2'000'000}, &stats);
+    const auto plans = planner::baseline::find_plans(p, {1, state.range(2)}, &stats);
     found = plans.size();
     cost = plans.empty() ? 0 : plans.front().cost;
   }
@@ -123,7 +124,8 @@ void BM_AStar(benchmark::State& state) {
 
 // find_plans as `plan` runs it (one order per block), for the best plan: "exact" = 1 when
 // it is proven optimal, else "gap_pct" is its proven distance from the optimum. The
-// expansion limit (not a time budget) keeps the result the same from run to run.
+// expansion limit (not a time budget) keeps the result the same from run to run. "kept"
+// and "groups": the primitives and atoms the search runs on (planner/search_reduce.hpp).
 void BM_Search(benchmark::State& state) {
   const auto p = synthetic_problem(int(state.range(0)), std::uint32_t(state.range(1)));
   planner::SearchOptions options{int(state.range(2)), state.range(3)};
@@ -131,6 +133,9 @@ void BM_Search(benchmark::State& state) {
   planner::SearchStats stats;
   std::vector<planner::Plan> plans;
   for (auto _ : state) plans = planner::find_plans(p, options, &stats);
+  const planner::Reduction reduced = planner::reduce(p);
+  state.counters["kept"] = double(reduced.problem.primitives.size());
+  state.counters["groups"] = double(reduced.problem.atoms.size());
   state.counters["expanded"] = double(stats.expanded);
   state.counters["plans"] = double(plans.size());
   state.counters["cost"] = plans.empty() ? 0 : plans.front().cost;
@@ -142,7 +147,8 @@ void BM_Search(benchmark::State& state) {
 // The search problems of the bundled parts on examples/machines/multitask-b-axis.yaml at
 // 0.5 mm, as `hybridctl plan -o` recorded them (bench/data/README.md): the search stage
 // alone (top 3, one order per block), against the baseline A* (arg 1 = 1; it stops at
-// 300,000 expansions here).
+// 300,000 expansions here). Arg 2 = 1 searches backwards instead of as find_plans chooses
+// (forwards here: the tolerance band's atoms are free).
 const char* const kMachineProblems[] = {"bracket", "overhang"};
 
 void BM_SearchMachine(benchmark::State& state) {
@@ -154,6 +160,7 @@ void BM_SearchMachine(benchmark::State& state) {
   planner::SearchOptions options{3, state.range(1) == 2 ? 5'000'000 : 10'000};
   options.block_orders = planner::BlockOrders::Cheapest;
   if (state.range(1) == 2) options.time_limit = 10;
+  if (state.range(2) == 1) options.direction = planner::SearchDirection::Backward;
   planner::SearchStats stats;
   std::vector<planner::Plan> plans;
   for (auto _ : state) {
@@ -163,7 +170,11 @@ void BM_SearchMachine(benchmark::State& state) {
       plans = planner::find_plans(p, options, &stats);
     }
   }
-  state.SetLabel(part + (state.range(1) == 1 ? " baseline" : state.range(1) == 2 ? " 10 s" : ""));
+  state.SetLabel(part + (state.range(1) == 1 ? " baseline" : state.range(1) == 2 ? " 10 s" : "") +
+                 (state.range(2) == 1 ? " backwards" : ""));
+  const planner::Reduction reduced = planner::reduce(p);
+  state.counters["kept"] = double(reduced.problem.primitives.size());
+  state.counters["groups"] = double(reduced.problem.atoms.size());
   state.counters["lower_bound"] = stats.lower_bound;
   state.counters["weight"] = stats.weight;
   state.counters["atoms"] = double(p.atoms.size());
@@ -176,7 +187,12 @@ void BM_SearchMachine(benchmark::State& state) {
 }
 
 BENCHMARK(BM_SearchMachine)
-    ->ArgsProduct({{0, 1}, {0, 1, 2}})
+    ->ArgsProduct({{0, 1}, {0, 2}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
+BENCHMARK(BM_SearchMachine)
+    ->ArgsProduct({{0, 1}, {1}, {0}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);
@@ -194,13 +210,24 @@ void BM_Exhaustive(benchmark::State& state) {
   state.counters["cost"] = cost;
 }
 
-BENCHMARK(BM_AStar)->ArgsProduct({{8, 12, 16, 24}, {11, 12, 13}})->Unit(benchmark::kMillisecond)->UseRealTime();
+// Issue 15's cases: n = 24 proven optimal (in at most 1 s), n = 64 within 10 s with a proven
+// gap of at most 5 %, n = 128 a plan and its gap within 30 s; the baseline on the same
+// instances in the same run (at 64 and 128 it stops at 20,000 expansions: it finds no plan).
+BENCHMARK(BM_AStar)
+    ->ArgsProduct({{8, 12, 16, 24}, {11, 12, 13}, {2'000'000}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_AStar)
+    ->ArgsProduct({{64, 128}, {11, 12, 13}, {20'000}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 BENCHMARK(BM_Search)
     ->ArgsProduct({{8, 12, 16, 24}, {11, 12, 13}, {1}, {2'000'000}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_Search)
-    ->ArgsProduct({{64, 128}, {11, 12, 13}, {1}, {20'000}})
+    ->ArgsProduct({{64, 128}, {11, 12, 13}, {1}, {150'000}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);

@@ -77,6 +77,46 @@ LowerBound::LowerBound(const PlanningProblem& p)
   };
   for (auto& l : adders_) std::stable_sort(l.begin(), l.end(), by_cost);
   for (auto& l : removers_) std::stable_sort(l.begin(), l.end(), by_cost);
+  index_lists();
+}
+
+// The distinct supplier lists and the bit masks fixed_part works with.
+void LowerBound::index_lists() {
+  const PlanningProblem& p = p_;
+  std::map<std::vector<int>, int> ids;
+  auto id_of = [&](const std::vector<int>& list) {
+    const auto [it, added] = ids.emplace(list, int(lists_.size()));
+    if (added) lists_.push_back(list);
+    return it->second;
+  };
+  for (int a = 0; a < atoms_; ++a) {
+    adder_list_.push_back(id_of(adders_[std::size_t(a)]));
+    remover_list_.push_back(id_of(removers_[std::size_t(a)]));
+  }
+  // The lists, tools and setups as bit masks over the primitives.
+  const std::size_t prim_words = (p.primitives.size() + 63) / 64;
+  auto mask = [&](auto member) {
+    std::vector<std::uint64_t> m(prim_words, 0);
+    for (std::size_t i = 0; i < p.primitives.size(); ++i)
+      if (member(int(i))) m[i / 64] |= std::uint64_t{1} << (i % 64);
+    return m;
+  };
+  for (const auto& list : lists_)
+    list_mask_.push_back(mask([&](int i) { return std::find(list.begin(), list.end(), i) != list.end(); }));
+  for (std::size_t t = 0; t < tool_id_.size(); ++t)  // ids are below the primitives' count
+    tool_mask_.push_back(mask([&](int i) { return tool_id_[std::size_t(i)] == int(t); }));
+  for (std::size_t t = 0; t < setup_id_.size(); ++t)
+    setup_mask_.push_back(mask([&](int i) { return setup_id_[std::size_t(i)] == int(t); }));
+}
+
+std::vector<char> LowerBound::needed_lists(const AtomSet& state) const {
+  std::vector<char> needed(lists_.size(), 0);
+  const auto& s = state.words();
+  for (std::size_t w = 0; w < s.size(); ++w) {
+    for (std::uint64_t b = must_in_[w] & ~s[w]; b; b &= b - 1) needed[std::size_t(adder_list_[w * 64 + std::size_t(std::countr_zero(b))])] = 1;
+    for (std::uint64_t b = must_out_[w] & s[w]; b; b &= b - 1) needed[std::size_t(remover_list_[w * 64 + std::size_t(std::countr_zero(b))])] = 1;
+  }
+  return needed;
 }
 
 std::vector<bool> LowerBound::usable(const std::vector<std::uint8_t>& uses, bool first) const {
@@ -112,20 +152,28 @@ double LowerBound::side_effects(const AtomSet& state, const Rates& r) const {
   // that are not must-in (deposited, and removed again when must-out) for an additive
   // one, present atoms that are not must-out (removed, and deposited again when must-in)
   // for a subtractive one.
+  // The rates looked up once per list of suppliers, and what changing each atom costs.
+  std::vector<double> rate(lists_.size());
+  for (std::size_t l = 0; l < lists_.size(); ++l) rate[l] = r.cheapest(lists_[l]);
+  std::vector<double> deposited(p_.atoms.size()), removed(p_.atoms.size());
+  for (std::size_t a = 0; a < std::size_t(atoms_); ++a) {
+    const double in = rate[std::size_t(adder_list_[a])], out = rate[std::size_t(remover_list_[a])];
+    const AtomSpec& atom = p_.atoms[a];
+    deposited[a] = atom.volume * (in + (atom.must_out ? out : 0));
+    removed[a] = atom.volume * (out + (atom.must_in ? in : 0));
+  }
   std::vector<double> side(p_.primitives.size(), 0);
   for (std::size_t i = 0; i < p_.primitives.size(); ++i) {
     if (!r.allowed[i]) continue;
     const PrimitiveSpec& prim = p_.primitives[i];
+    const bool adds = prim.mode == Mode::Additive;
     const auto& pa = prim.atoms.words();
     double c = 0;
     for (std::size_t w = 0; w < s.size(); ++w) {
-      const std::uint64_t touched = prim.mode == Mode::Additive ? pa[w] & ~s[w] & ~must_in_[w] : pa[w] & s[w] & ~must_out_[w];
+      const std::uint64_t touched = adds ? pa[w] & ~s[w] & ~must_in_[w] : pa[w] & s[w] & ~must_out_[w];
       for (std::uint64_t b = touched; b; b &= b - 1) {
         const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
-        const AtomSpec& atom = p_.atoms[a];
-        const bool undo = prim.mode == Mode::Additive ? atom.must_out : atom.must_in;
-        c += atom.volume * (prim.mode == Mode::Additive ? r.deposit(a) + (undo ? r.remove(a) : 0)
-                                                        : r.remove(a) + (undo ? r.deposit(a) : 0));
+        c += adds ? deposited[a] : removed[a];
       }
     }
     side[i] = c;
@@ -137,13 +185,43 @@ double LowerBound::side_effects(const AtomSet& state, const Rates& r) const {
       if (r.allowed[std::size_t(i)]) best = std::min(best, side[std::size_t(i)]);
     return best;
   };
+  // Adders and removers are never in one list (a list is of one mode), so each needed list
+  // is an obligation of one kind.
   double add = 0, remove = 0;
-  for (std::size_t w = 0; w < s.size(); ++w) {
-    for (std::uint64_t b = must_in_[w] & ~s[w]; b; b &= b - 1) add = std::max(add, least(adders_[w * 64 + std::size_t(std::countr_zero(b))]));
-    for (std::uint64_t b = must_out_[w] & s[w]; b; b &= b - 1)
-      remove = std::max(remove, least(removers_[w * 64 + std::size_t(std::countr_zero(b))]));
+  const std::vector<char> needed = needed_lists(state);
+  for (std::size_t l = 0; l < lists_.size(); ++l) {
+    if (!needed[l] || lists_[l].empty()) continue;
+    const bool adds = p_.primitives[std::size_t(lists_[l].front())].mode == Mode::Additive;
+    (adds ? add : remove) = std::max(adds ? add : remove, least(lists_[l]));
   }
   return add + remove;
+}
+
+// The tools and setups some needed atom of `state` can only be changed with.
+void LowerBound::force(const AtomSet& state, const Rates& r, std::vector<bool>& tool_forced,
+                       std::vector<bool>& setup_forced) const {
+  // As bit masks over the primitives: the allowed ones of a list all of one tool (setup)
+  // force it.
+  std::vector<std::uint64_t> allowed_mask((p_.primitives.size() + 63) / 64, 0);
+  for (std::size_t i = 0; i < p_.primitives.size(); ++i)
+    if (r.allowed[i]) allowed_mask[i / 64] |= std::uint64_t{1} << (i % 64);
+  auto force_one = [&](const std::vector<std::uint64_t>& list, const std::vector<int>& id,
+                   const std::vector<std::vector<std::uint64_t>>& of_id, std::vector<bool>& forced) {
+    int first_member = -1;
+    for (std::size_t w = 0; w < list.size() && first_member < 0; ++w)
+      if (list[w] & allowed_mask[w]) first_member = int(w * 64) + std::countr_zero(list[w] & allowed_mask[w]);
+    if (first_member < 0) return;
+    const auto& same = of_id[std::size_t(id[std::size_t(first_member)])];
+    for (std::size_t w = 0; w < list.size(); ++w)
+      if (list[w] & allowed_mask[w] & ~same[w]) return;
+    forced[std::size_t(id[std::size_t(first_member)])] = true;
+  };
+  const std::vector<char> needed = needed_lists(state);
+  for (std::size_t l = 0; l < lists_.size(); ++l)
+    if (needed[l]) {
+      force_one(list_mask_[l], tool_id_, tool_mask_, tool_forced);
+      force_one(list_mask_[l], setup_id_, setup_mask_, setup_forced);
+    }
 }
 
 double LowerBound::fixed_part(const AtomSet& state, const Rates& r, int last) const {
@@ -170,22 +248,7 @@ double LowerBound::fixed_part(const AtomSet& state, const Rates& r, int last) co
   }
   // Tools (setups) that some needed atom can only be changed with.
   std::vector<bool> tool_forced(tool_id_.size() + 1, false), setup_forced(setup_id_.size() + 1, false);
-  auto force = [&](const std::vector<int>& suppliers) {
-    int tool = -1, setup = -1;
-    bool one_tool = true, one_setup = true;
-    for (int i : suppliers) {
-      if (!allowed(i)) continue;
-      if (tool < 0) tool = tool_id_[std::size_t(i)], setup = setup_id_[std::size_t(i)];
-      one_tool = one_tool && tool_id_[std::size_t(i)] == tool;
-      one_setup = one_setup && setup_id_[std::size_t(i)] == setup;
-    }
-    if (tool >= 0 && one_tool) tool_forced[std::size_t(tool)] = true;
-    if (setup >= 0 && one_setup) setup_forced[std::size_t(setup)] = true;
-  };
-  for (std::size_t w = 0; w < s.size(); ++w) {
-    for (std::uint64_t b = must_out_[w] & s[w]; b; b &= b - 1) force(removers_[w * 64 + std::size_t(std::countr_zero(b))]);
-    for (std::uint64_t b = must_in_[w] & ~s[w]; b; b &= b - 1) force(adders_[w * 64 + std::size_t(std::countr_zero(b))]);
-  }
+  force(state, r, tool_forced, setup_forced);
   // Each forced tool other than the current one is changed to at least once; at the
   // start, the first action's tool comes free.
   auto changes = [&](const std::vector<bool>& forced, int current) {

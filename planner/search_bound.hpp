@@ -18,7 +18,7 @@
 // (planner/search_reduce.hpp: SuffixClosure), which makes every part larger and tells
 // dead ends: a wrong atom none of them can fix.
 // The bound is consistent (it never falls by more than an action costs), which the
-// search's duplicate detection relies on; tests/planner/search_bound_test.cpp checks both
+// search's duplicate detection relies on; tests/planner/search_test.cpp checks both
 // properties against the exhaustive enumerator.
 
 #include <cstdint>
@@ -53,12 +53,22 @@ class LowerBound {
   double atom_part(const AtomSet& state, const Rates& r) const;
   double side_effects(const AtomSet& state, const Rates& r) const;
   double fixed_part(const AtomSet& state, const Rates& r, int last) const;
+  void index_lists();
+  void force(const AtomSet& state, const Rates& r, std::vector<bool>& tool_forced, std::vector<bool>& setup_forced) const;
 
   const PlanningProblem& p_;
   SuffixClosure closure_;
   int atoms_ = 0;
   std::vector<std::uint64_t> must_in_, must_out_;  // masks
   std::vector<std::vector<int>> adders_, removers_;  // per atom, cheapest first
+  // The distinct lists among adders_ and removers_, and per atom which its lists are: many
+  // atoms share one, and what the lists force is worked out once per list.
+  std::vector<std::vector<int>> lists_;
+  std::vector<int> adder_list_, remover_list_;
+  // Bit masks over the primitives: per list its members, per tool (setup) id its primitives.
+  std::vector<std::vector<std::uint64_t>> list_mask_, tool_mask_, setup_mask_;
+  // Per list with a wrong atom in `state` (must-in missing: adders; must-out present: removers).
+  std::vector<char> needed_lists(const AtomSet& state) const;
   std::vector<int> tool_id_, setup_id_;               // per primitive
   std::vector<double> setup_entry_;                   // per setup id: the least a change into it costs
   std::vector<bool> dirty_;  // an additive primitive holding a must-out atom
