@@ -28,6 +28,11 @@ BackwardSearch::BackwardSearch(const PlanningProblem& p, const SearchOptions& o,
   must_in_ = mask_of(p, [](const AtomSpec& a) { return a.must_in; });
   const auto must_out = mask_of(p, [](const AtomSpec& a) { return a.must_out; });
   adders_.resize(p.atoms.size());
+  for (const PrimitiveSpec& prim : p.primitives) {
+    adds_.push_back(prim.mode == Mode::Additive);
+    rate_.push_back(prim.cost_per_mm3);
+  }
+  for (const AtomSpec& atom : p.atoms) volume_.push_back(atom.volume);
   for (int i = 0; i < int(p.primitives.size()); ++i) {
     const auto& atoms = p.primitives[std::size_t(i)].atoms.words();
     const auto& mask = additive(p, i) ? must_out : must_in_;
@@ -58,20 +63,22 @@ double BackwardSearch::cheapest_rate(std::size_t a, const std::vector<std::uint8
 // What atom `a` adds to the bound: deposited by its earliest toucher, then or before at no
 // less than the cheapest rate left; undecided and must-in, deposited at least once.
 double BackwardSearch::owed(std::size_t a, int earliest, double cheapest) const {
-  const double volume = p_.atoms[a].volume;
+  const double volume = volume_[a];
   if (earliest >= 0)
-    return additive(p_, earliest) ? volume * std::min(p_.primitives[std::size_t(earliest)].cost_per_mm3, cheapest) : 0.0;
+    return adds_[std::size_t(earliest)] ? volume * std::min(rate_[std::size_t(earliest)], cheapest) : 0.0;
   return p_.atoms[a].must_in ? volume * cheapest : 0.0;
 }
 
 BackwardSearch::View BackwardSearch::view_of(int id) const {
   const std::size_t atoms = p_.atoms.size();
-  View v{std::vector<int>(atoms, -1), std::vector<std::uint64_t>(must_in_.size(), 0), std::vector<double>(atoms, 0),
+  View v{std::vector<int>(atoms, -1), std::vector<std::uint64_t>(must_in_.size(), 0),
+         std::vector<std::uint64_t>(must_in_.size(), 0), std::vector<double>(atoms, 0),
          std::vector<double>(atoms, 0), std::vector<double>(atoms, kInfinity), std::vector<int>(atoms, -1), 0};
   for (int n = id; nodes_[std::size_t(n)].primitive >= 0; n = nodes_[std::size_t(n)].parent) {
     const int i = nodes_[std::size_t(n)].primitive;
     const auto& held = p_.primitives[std::size_t(i)].atoms.words();
     for (std::size_t w = 0; w < held.size(); ++w) {
+      if (adds_[std::size_t(i)]) v.deposited[w] |= held[w] & ~v.decided[w];
       for (std::uint64_t b = held[w] & ~v.decided[w]; b; b &= b - 1) {
         const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
         v.earliest[a] = i;
@@ -139,31 +146,34 @@ std::vector<std::uint64_t> BackwardSearch::key_of(const Node& node, const View& 
 // before them, plus the fixed costs between i and the suffix's first action.
 double BackwardSearch::step_cost(int i, const Node& node, const View& v) const {
   double step = node.primitive >= 0 ? fixed_cost(p_, i, node.primitive) : 0;
-  const bool adds = additive(p_, i);
+  const bool adds = adds_[std::size_t(i)];
   const auto& held = p_.primitives[std::size_t(i)].atoms.words();
-  for (std::size_t w = 0; w < held.size(); ++w)
-    for (std::uint64_t b = held[w] & v.decided[w]; b; b &= b - 1) {
-      const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
-      if (additive(p_, v.earliest[a]) != adds) step += v.flip[a];
-    }
+  for (std::size_t w = 0; w < held.size(); ++w) {
+    // The earliest touchers of the other mode change the atom after i.
+    const std::uint64_t other = adds ? v.decided[w] & ~v.deposited[w] : v.deposited[w];
+    for (std::uint64_t b = held[w] & other; b; b &= b - 1) step += v.flip[w * 64 + std::size_t(std::countr_zero(b))];
+  }
   return step / p_.normaliser;
 }
 
 // The child's bound, from the node's: only the shares of i's atoms change (their earliest
 // toucher is i now, and i may have been their cheapest deposit left).
 double BackwardSearch::child_bound(int i, const View& v, const std::vector<std::uint8_t>& uses) const {
-  const bool used_up = uses[std::size_t(i)] >= p_.max_uses;
+  const bool used_up = uses[std::size_t(i)] >= p_.max_uses, adds = adds_[std::size_t(i)];
+  const double rate = rate_[std::size_t(i)];
   double h = v.bound;
   const auto& held = p_.primitives[std::size_t(i)].atoms.words();
   for (std::size_t w = 0; w < held.size(); ++w)
     for (std::uint64_t b = held[w]; b; b &= b - 1) {
       const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
+      h -= v.owed[a];
+      if (!adds) continue;  // i removes it: no share
       int by = v.cheapest_by[a];
       const double cheapest = used_up && by == i ? cheapest_rate(a, uses, by) : v.cheapest[a];
-      h += owed(a, i, cheapest) - v.owed[a];
+      h += volume_[a] * std::min(rate, cheapest);
     }
   if (h == kInfinity || std::isnan(h)) return kInfinity;
-  if (!additive(p_, i)) h += p_.fixed.mode_switch;  // the plan starts with a deposit: a switch before i
+  if (!adds) h += p_.fixed.mode_switch;  // the plan starts with a deposit: a switch before i
   return std::max(0.0, h) / p_.normaliser;
 }
 

@@ -72,6 +72,7 @@ class BackwardSearch {
   struct View {
     std::vector<int> earliest;  // per atom: the suffix's earliest toucher, -1 undecided
     std::vector<std::uint64_t> decided;
+    std::vector<std::uint64_t> deposited;  // the decided atoms whose earliest toucher deposits them
     std::vector<double> flip;     // per decided atom: what its earliest toucher pays if it changes it
     std::vector<double> owed;     // per atom: its share of the bound
     std::vector<double> cheapest;  // per atom: the cheapest rate of a deposit not used up
@@ -100,6 +101,8 @@ class BackwardSearch {
   std::vector<std::uint64_t> must_in_;             // mask
   std::vector<std::vector<std::uint64_t>> wrong_;  // per primitive: the atoms its mode gets wrong
   std::vector<std::vector<int>> adders_;           // per atom, cheapest first
+  std::vector<char> adds_;                         // per primitive: additive
+  std::vector<double> rate_, volume_;              // per primitive, per atom
   std::deque<Node> nodes_;
   std::priority_queue<Entry, std::vector<Entry>, Worse> open_;
   std::int64_t seq_ = 0;
