@@ -10,6 +10,9 @@ namespace hybridctl::planner::detail {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
+// How far above the f it comes up at a node's children are stored, as a share of the bound
+// at the start: wide enough that a node is seldom expanded more than a few times.
+constexpr double kWindow = 0.002;
 
 std::vector<std::uint64_t> mask_of(const PlanningProblem& p, bool (*in)(const AtomSpec&)) {
   std::vector<std::uint64_t> mask(std::size_t((p.atoms.size() + 63) / 64), 0);
@@ -177,23 +180,38 @@ double BackwardSearch::child_bound(int i, const View& v, const std::vector<std::
   return std::max(0.0, h) / p_.normaliser;
 }
 
-void BackwardSearch::expand(int id, const View& v) {
-  const Node& node = nodes_[std::size_t(id)];
-  if (whole(node, v.decided)) {
+// Partial expansion: only the children with f up to `f` + window_ are stored, the others
+// wait: the node goes back on the open list at the least f among them, and is expanded
+// again when that comes up. Most children never would be, and the states they took were
+// what stopped the search (max_states) before its expansions ran out.
+void BackwardSearch::expand(int id, const View& v, double f) {
+  Node& node = nodes_[std::size_t(id)];
+  const bool again = node.upto > -kInfinity;
+  if (!again && whole(node, v.decided)) {
     const double cost = node.g + start_cost(v);
     if (cost < prune_at_) open_.push({cost, cost, seq_++, id, true});
   }
   if (node.primitive >= 0 && p_.primitives[std::size_t(node.primitive)].raw_stock) return;  // raw stock only first
+  const double upto = f + window_;
+  double rest = kInfinity;
   for (int i = 0; i < int(p_.primitives.size()); ++i) {
-    if (!may_precede(i, nodes_[std::size_t(id)], v.decided)) continue;
-    Node child{id, i, nodes_[std::size_t(id)].g + step_cost(i, nodes_[std::size_t(id)], v), nodes_[std::size_t(id)].uses};
+    if (!may_precede(i, node, v.decided)) continue;
+    Node child{id, i, node.g + step_cost(i, node, v), node.uses};
     ++child.uses[std::size_t(i)];
     const double h = child_bound(i, v, child.uses);
     if (h == kInfinity || child.g + h >= prune_at_) continue;
+    const double child_f = child.g + o_.weight * h;
+    if (again && child_f <= node.upto) continue;  // stored before
+    if (child_f > upto) {
+      rest = std::min(rest, child_f);
+      continue;
+    }
     ++st_.generated;
     nodes_.push_back(std::move(child));
-    open_.push({nodes_.back().g + o_.weight * h, nodes_.back().g, seq_++, int(nodes_.size()) - 1, false});
+    open_.push({child_f, nodes_.back().g, seq_++, int(nodes_.size()) - 1, false});
   }
+  node.upto = upto;
+  if (rest < kInfinity) open_.push({rest, node.g, seq_++, id, false});
 }
 
 Plan BackwardSearch::plan_of(int id) const {
@@ -210,6 +228,7 @@ std::vector<Plan> BackwardSearch::run(int wanted) {
   nodes_.push_back({-1, -1, 0, std::vector<std::uint8_t>(p_.primitives.size(), 0)});
   const double h0 = view_of(0).bound / p_.normaliser;
   if (h0 == kInfinity) return plans;
+  window_ = kWindow * h0;
   open_.push({o_.weight * h0, 0, seq_++, 0, false});
   std::unordered_map<std::vector<std::uint64_t>, int, KeyHash> pops;
   while (!open_.empty() && int(plans.size()) < wanted) {
@@ -228,13 +247,14 @@ std::vector<Plan> BackwardSearch::run(int wanted) {
       break;
     }
     const View v = view_of(e.node);
-    if (e.node != 0) {
+    if (e.node != 0 && !nodes_[std::size_t(e.node)].counted) {
       int& count = pops[key_of(nodes_[std::size_t(e.node)], v)];
       if (count >= o_.top_k + goals_.passed() + invalid_) {
         open_.pop();
         continue;
       }
       ++count;
+      nodes_[std::size_t(e.node)].counted = true;
     }
     if (out_of_room()) {
       limit_ = true;
@@ -242,7 +262,7 @@ std::vector<Plan> BackwardSearch::run(int wanted) {
     }
     open_.pop();
     ++st_.expanded;
-    expand(e.node, v);
+    expand(e.node, v, e.f);
   }
   frontier_ = open_.empty() ? kInfinity : open_.top().f;
   return plans;

@@ -53,6 +53,8 @@ class BackwardSearch {
     int primitive = -1;  // the suffix's first action
     double g = 0;        // normalised: what the suffix's actions pay, but for its earliest touchers
     std::vector<std::uint8_t> uses;
+    double upto = -std::numeric_limits<double>::infinity();  // children with f up to this are stored
+    bool counted = false;  // its arrival at its state is counted (duplicate detection)
   };
   struct Entry {
     double f, g;
@@ -88,7 +90,7 @@ class BackwardSearch {
   double start_cost(const View& v) const;
   double step_cost(int i, const Node& node, const View& v) const;
   double child_bound(int i, const View& v, const std::vector<std::uint8_t>& uses) const;
-  void expand(int id, const View& v);
+  void expand(int id, const View& v, double f);
   std::vector<std::uint64_t> key_of(const Node& node, const View& v) const;
   Plan plan_of(int id) const;
 
@@ -109,6 +111,7 @@ class BackwardSearch {
   double frontier_ = std::numeric_limits<double>::infinity();
   bool limit_ = false;
   std::int64_t invalid_ = 0;  // whole plans passed over as not valid forwards
+  double window_ = 0;         // partial expansion: see expand()
 };
 
 }  // namespace hybridctl::planner::detail
