@@ -19,8 +19,11 @@
 // an earlier deposit, at no less than the cheapest rate left; an undecided must-in atom is
 // deposited at least once at that rate; a suffix that starts with a removal needs a mode
 // switch before it. It is consistent. Reach (blocked_by) and footing need the state before
-// an action, which only the whole plan gives: plans are checked forward when complete and
-// passed over when a step cannot be taken or changes nothing.
+// an action, which only the whole plan gives: plans are replayed forwards when complete and
+// passed over when a step cannot be taken, changes nothing or comes after the goal.
+//
+// Expansion is partial (expand()): a suffix stores only its children with f near its own,
+// and comes up again for the rest, which keeps the states stored far below max_states.
 
 #include <chrono>
 #include <cstdint>
