@@ -129,7 +129,10 @@ void Search::expand(int id) {
     ++child.uses[std::size_t(i)];
     // The quick bound orders the child for now; the full one is computed when it comes
     // up (most children never do).
-    const double h = bound_.quick(child.state, child.uses, i);
+    std::vector<bool> within = usable;  // the node's, less what the child cannot use
+    if (child.uses[std::size_t(i)] >= p_.max_uses) within[std::size_t(i)] = false;
+    for (std::size_t j = 0; j < within.size() && id == 0; ++j) within[j] = within[j] && !p_.primitives[j].raw_stock;
+    const double h = bound_.quick(child.state, within, i);
     if (h == kInfinity || child.g + h >= prune_at_) continue;
     ++st_.generated;
     nodes_.push_back(std::move(child));

@@ -269,7 +269,11 @@ double LowerBound::fixed_part(const AtomSet& state, const Rates& r, int last) co
 }
 
 double LowerBound::quick(const AtomSet& state, const std::vector<std::uint8_t>& uses, int last) const {
-  const Rates r = rates(uses, last < 0);
+  return quick(state, usable(uses, last < 0), last);
+}
+
+double LowerBound::quick(const AtomSet& state, const std::vector<bool>& within, int last) const {
+  const Rates r{*this, within};
   const double atoms = atom_part(state, r);
   if (atoms == kInfinity) return kInfinity;
   return (atoms + fixed_part(state, r, last)) / p_.normaliser;

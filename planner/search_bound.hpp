@@ -41,6 +41,9 @@ class LowerBound {
 
   // Only the atom part and the fixed costs: cheaper, never above operator().
   double quick(const AtomSet& state, const std::vector<std::uint8_t>& uses, int last) const;
+  // The same with `within` taken as the primitives still allowed: any superset of usable()
+  // (a parent's, less what the child used up) keeps it a bound, and saves the closure.
+  double quick(const AtomSet& state, const std::vector<bool>& within, int last) const;
 
   // The primitives a completion may still use: not used up, no raw stock after the first
   // action, and held by some suffix of a plan reaching the goal.
