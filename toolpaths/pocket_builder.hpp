@@ -54,6 +54,7 @@ class PocketBuilder {
   Solid allowed_tips() const;
   void start_column_tops();
   Levels cutting_levels() const;
+  void held_rows(int y, int z, std::vector<std::uint64_t>& held) const;
   SliceMask usable_tips(const Solid& allowed, int k) const;
   SliceMask useful_tips(const SliceMask& usable, int k) const;
   void clear_level(const SliceMask& useful, const SliceMask& usable, int k, int level_number);

@@ -230,18 +230,25 @@ void PocketBuilder::start_column_tops() {
   refresh_tops(tops_box_);
 }
 
-// Top-down every `down` voxels from the top, plus every floor of the ROI.
+// Top-down every `down` voxels from the top, plus every floor of the ROI: material with
+// something that must remain under it before the next level down (a step-down at most),
+// where the tip cannot go lower. Material over air needs no level of its own: the next
+// level down reaches under it and the flutes take it from the side (the cutter's discs
+// over its tip), as a scalloped deposit's wall is milled in step-downs, not layer by layer.
 PocketBuilder::Levels PocketBuilder::cutting_levels() const {
   const IndexBox rb = remaining_.bounding_box();
   Levels levels;
   for (int k = rb.hi.z - down_; k > rb.lo.z; k -= down_) levels.insert(k);
   levels.insert(rb.lo.z);
+  std::vector<std::uint64_t> held;  // per word of a row: something that stays within a step-down below
   for (int z = rb.lo.z + 1; z < rb.hi.z; ++z) {
     bool floor_here = false;
     for (int y = rb.lo.y; y < rb.hi.y && !floor_here; ++y) {
       const auto now = remaining_.row(y, z), below = remaining_.row(y, z - 1);
+      held.assign(now.size(), 0);
+      for (int d = 1; d <= down_ && !untouchable_.empty(); ++d) held_rows(y, z - d, held);
       for (std::size_t w = 0; w < now.size(); ++w)
-        if (now[w] & ~below[w]) {
+        if (now[w] & ~below[w] & held[w]) {
           floor_here = true;
           break;
         }
@@ -249,6 +256,19 @@ PocketBuilder::Levels PocketBuilder::cutting_levels() const {
     if (floor_here) levels.insert(z);
   }
   return levels;
+}
+
+// ORs the untouchable voxels of row (y, z) into `held`, on remaining_'s words (words
+// are whole 64-voxel runs of X in every solid, so they line up).
+void PocketBuilder::held_rows(int y, int z, std::vector<std::uint64_t>& held) const {
+  const IndexBox mine = remaining_.storage_box(), theirs = untouchable_.storage_box();
+  if (y < theirs.lo.y || y >= theirs.hi.y || z < theirs.lo.z || z >= theirs.hi.z) return;
+  const auto row = untouchable_.row(y, z);
+  const int shift = (mine.lo.x - theirs.lo.x) / 64;
+  for (std::size_t w = 0; w < held.size(); ++w) {
+    const int u = int(w) + shift;
+    if (u >= 0 && u < int(row.size())) held[w] |= row[std::size_t(u)];
+  }
 }
 
 // The allowed tips at level k less those whose shank or holder would meet material still
