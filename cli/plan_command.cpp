@@ -33,6 +33,7 @@ struct PlanArgs {
   std::vector<std::string> stock_files;
   bool no_validate = false;
   bool no_bands = false;
+  bool no_fine_graining = false;
   std::string objective;
   int max_rejected = 200;
   bool report = false;
@@ -64,6 +65,7 @@ int run_plan(const PlanArgs& args) {
   // Every plan offered is proven by execution first (validation/, docs/validation.md).
   if (!args.no_validate) validation::use_validation(options, machine);
   options.bands = !args.no_bands;
+  options.fine_graining = !args.no_fine_graining;
   options.objective = objective(args.objective);
   options.max_rejected = args.max_rejected;
   ProgressBar bar("planning");
@@ -160,6 +162,9 @@ void add_plan_command(CLI::App& app, Runner& runner) {
   cmd->add_flag("--no-bands", args->no_bands,
                 "Search without banded primitives (\"mill up to here, deposit from here on\", docs/bands.md): only "
                 "whole-part ones, for comparison and benchmarks");
+  cmd->add_flag("--no-fine-graining", args->no_fine_graining,
+                "Do not split atoms that straddle the design with primitives restricted to their neighbourhood "
+                "(iterative fine-graining, docs/bands.md): for comparison and benchmarks");
   add_objective_option(cmd, args->objective);
   cmd->add_option("--max-rejected", args->max_rejected,
                   "How many candidate plans validation may turn down before the search gives up")

@@ -333,6 +333,12 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
                     {"modality", modality_name(r.verdict.modality)},
                     {"summary", r.verdict.summary},
                     {"violations", violations}};
+  json unsplit = json::array();
+  for (const FineGraining::Unsplit& u : r.fine_graining.unsplit) unsplit.push_back({{"atom", u.atom}, {"why", u.why}});
+  doc["fine_graining"] = {{"rounds", r.fine_graining.rounds},
+                          {"added", r.fine_graining.added},
+                          {"capped", r.fine_graining.capped},
+                          {"unsplit", unsplit}};
   doc["search"] = {{"expanded", r.search.expanded},
                    {"generated", r.search.generated},
                    {"exhausted", r.search.exhausted},
@@ -418,6 +424,12 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
   os << "atoms       " << r.measures.size() << ": " << counts[int(AtomClass::MustIn)] << " must-in, "
      << counts[int(AtomClass::MustOut)] << " must-out, " << counts[int(AtomClass::Free)] << " free (" << slivers
      << " slivers), " << counts[int(AtomClass::Violating)] << " violating\n";
+  if (r.fine_graining.added > 0)
+    os << "fine-grain  " << r.fine_graining.added << " primitive" << (r.fine_graining.added == 1 ? "" : "s")
+       << " restricted to the neighbourhood of atoms that straddled the design, in " << r.fine_graining.rounds
+       << " round" << (r.fine_graining.rounds == 1 ? "" : "s")
+       << (r.fine_graining.capped ? " (stopped at the cap of " + std::to_string(kMaxFineGrainedPrimitives) + ")" : "")
+       << "\n";
   os << "verdict     "
      << (r.verdict.manufacturable ? "manufacturable"
          : r.search.limit_reached && !r.verdict.decided_without_search ? "UNDECIDED"

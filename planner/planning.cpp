@@ -17,6 +17,7 @@
 #include "instruments/elements.hpp"
 #include "planner/bands.hpp"
 #include "planner/deposit_reach.hpp"
+#include "planner/fine_graining.hpp"
 #include "planner/memory_estimate.hpp"
 #include "planner/repair_primitives.hpp"
 
@@ -375,9 +376,17 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
   clock.lap("primitives");
   decompose_into_atoms(progress, r);
   clock.lap("atoms");
+  if (options.fine_graining) {
+    const Solid* present = options.stock_files.size() == 1 ? &r.primitives.front().region : nullptr;
+    r.fine_graining = fine_grain(machine, r.design, r.tolerance, r.sliver_threshold, present, r.primitives, r.atoms, r.measures);
+    clock.lap("fine-graining");
+  }
   r.problem = symbolic_problem(r, machine, options.max_uses);
   r.problem.start_from_stock = !options.stock_files.empty();
   r.verdict = check_manufacturability(r.problem, r.measures, r.lattice);
+  for (ViolatingAtom& v : r.verdict.violations)
+    for (const FineGraining::Unsplit& u : r.fine_graining.unsplit)
+      if (u.atom == v.atom) v.description += "; " + u.why;
   clock.lap("check");
   double validation_seconds = 0;
   if (r.verdict.manufacturable) search_plans(top_k, options, progress, r, validation_seconds);

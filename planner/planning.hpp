@@ -10,6 +10,7 @@
 #include "config/machine.hpp"
 #include "geometry/mesh.hpp"
 #include "planner/atoms.hpp"
+#include "planner/fine_graining.hpp"
 #include "planner/check.hpp"
 #include "planner/costing.hpp"
 #include "planner/deviation.hpp"
@@ -43,6 +44,9 @@ struct PlanningOptions {
   std::vector<PrimitiveFile> extra_primitives;
   // Banded primitives (planner/bands.hpp): "mill up to here, deposit from here on".
   bool bands = true;
+  // Iterative fine-graining (planner/fine_graining.hpp): split atoms that straddle the
+  // design with primitives restricted to their neighbourhood.
+  bool fine_graining = true;
   // What the search minimises (planner/costing.hpp); unset: the machine file's.
   std::optional<config::Objective> objective;
   // Raw stocks as files (STL or .vdb on the plan's grid) in the part's frame: a casting, a
@@ -89,6 +93,7 @@ struct PlanningResult {
   std::vector<RejectedPlan> rejected;  // candidates validation turned down, in the order found
   bool validated = false;              // the plans were validated (PlanningOptions::validate)
   SearchStats search;
+  FineGraining fine_graining;  // what fine-graining added, and what it could not split
   // What the plans' costs are in (minutes, money or cost factors), and each plan's
   // estimate in minutes and money whatever the objective, with the machine's currency.
   config::Objective objective = config::Objective::CostFactor;
