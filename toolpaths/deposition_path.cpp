@@ -63,8 +63,12 @@ struct RasterResult {
   int dropped = 0;
 };
 
+// Where a line leaves the region into `wall` (material already there in this layer) its
+// pass runs to the region's edge instead of stopping `inset` short: the bead's round end
+// then fuses with the wall instead of leaving notches between the tracks against it (a
+// repair deposit's edge along the worn face).
 RasterResult raster_layer(const SliceMask& region, const geometry::Lattice& lattice, double angle_deg, double spacing,
-                          double min_length, double inset, bool reverse_start) {
+                          double min_length, double inset, bool reverse_start, const SliceMask* wall = nullptr) {
   RasterResult out;
   const double h = lattice.voxel_size, ox = lattice.origin.x, oy = lattice.origin.y;
   const double a = angle_deg * std::numbers::pi / 180.0;
@@ -99,18 +103,25 @@ RasterResult raster_layer(const SliceMask& region, const geometry::Lattice& latt
     double next_x = d.x != 0 ? t0 + ((ox + (ix + (step_x > 0 ? 1 : 0)) * h) - s.x) / d.x : inf;
     double next_y = d.y != 0 ? t0 + ((oy + (iy + (step_y > 0 ? 1 : 0)) * h) - s.y) / d.y : inf;
     const double delta_x = d.x != 0 ? h / std::abs(d.x) : inf, delta_y = d.y != 0 ? h / std::abs(d.y) : inf;
-    std::vector<std::pair<double, double>> intervals;
+    struct Interval {
+      double ta, tb;
+      bool wall_a, wall_b;  // the line enters from / leaves into material already there
+    };
+    std::vector<Interval> intervals;
     double t = t0, open_at = 0;
-    bool open = false;
+    bool open = false, open_wall = false;
+    int px = ix, py = iy;
     while (t < t1) {
       const bool in = region.at(ix, iy);
       if (in && !open) {
         open = true;
         open_at = t;
+        open_wall = wall && wall->at(px, py);
       } else if (!in && open) {
         open = false;
-        intervals.push_back({open_at, t});
+        intervals.push_back({open_at, t, open_wall, wall && wall->at(ix, iy)});
       }
+      px = ix, py = iy;
       if (next_x < next_y) {
         t = next_x;
         next_x += delta_x;
@@ -121,17 +132,18 @@ RasterResult raster_layer(const SliceMask& region, const geometry::Lattice& latt
         iy += step_y;
       }
     }
-    if (open) intervals.push_back({open_at, t1});
+    if (open) intervals.push_back({open_at, t1, open_wall, false});
     std::vector<Pass> line;
-    for (auto [ta, tb] : intervals) {
-      const double length = tb - ta;
+    for (const Interval& i : intervals) {
+      const double length = i.tb - i.ta;
       if (length < min_length - 1e-9) {
         ++out.dropped;
         continue;
       }
       const double e = std::min(inset, std::max(0.0, 0.5 * (length - h)));
-      const Vec2 p{n.x * u + d.x * (ta + e), n.y * u + d.y * (ta + e)};
-      const Vec2 q{n.x * u + d.x * (tb - e), n.y * u + d.y * (tb - e)};
+      const double ea = i.wall_a ? 0.0 : e, eb = i.wall_b ? 0.0 : e;
+      const Vec2 p{n.x * u + d.x * (i.ta + ea), n.y * u + d.y * (i.ta + ea)};
+      const Vec2 q{n.x * u + d.x * (i.tb - eb), n.y * u + d.y * (i.tb - eb)};
       line.push_back({{p, q}});
     }
     // Serpentine: every other line runs backwards.
@@ -201,7 +213,7 @@ class DepositionBuilder {
   SliceMask layer_region(double zb, int& k) const;
   void drop_blocked(SliceMask& region, int k, int layer, double zb);
   void drop_overhangs(SliceMask& region, int layer, double zb);
-  std::vector<Pass> passes_of(const SliceMask& region, int layer, double angle);
+  std::vector<Pass> passes_of(const SliceMask& region, const SliceMask& wall, int layer, double angle);
   void finish();
 
   double corridor_top(Vec2 a, Vec2 b) const;
@@ -217,6 +229,7 @@ class DepositionBuilder {
   geometry::Lattice lattice_;
   double h_ = 1, oz_ = 0;
   Solid roi_;
+  Solid existing_;   // material present before the action
   IndexBox window_;  // the columns: ROI and existing material, with room for the nozzle
   std::vector<int> existing_top_index_;
   ColumnMap existing_top_, deposited_top_, travel_top_;
@@ -238,6 +251,7 @@ void DepositionBuilder::run(const Solid& roi_all, const Solid& existing) {
   oz_ = lattice_.origin.z;
   // Material already there is not deposited again.
   roi_ = existing.empty() ? roi_all : geometry::subtract(roi_all, existing);
+  existing_ = existing;
   const IndexBox roi_box = roi_.bounding_box();
   const IndexBox existing_box = existing.bounding_box();
   travel_ = head_.travel_clearance;
@@ -431,7 +445,7 @@ void DepositionBuilder::drop_overhangs(SliceMask& region, int layer, double zb) 
 }
 
 // The layer's passes in order: rasters, and the contour before or after them.
-std::vector<Pass> DepositionBuilder::passes_of(const SliceMask& region, int layer, double angle) {
+std::vector<Pass> DepositionBuilder::passes_of(const SliceMask& region, const SliceMask& wall, int layer, double angle) {
   const bool reverse_start = (layer / int(angles_.size())) % 2 == 1;
   std::vector<Pass> contour;
   RasterResult infill;
@@ -439,7 +453,7 @@ std::vector<Pass> DepositionBuilder::passes_of(const SliceMask& region, int laye
     contour = contour_layer(region, lattice_, inset_, min_length_);
     infill = raster_layer(shrink_by_disc(region, s_ / h_), lattice_, angle, s_, min_length_, inset_, reverse_start);
   } else {
-    infill = raster_layer(region, lattice_, angle, s_, min_length_, inset_, reverse_start);
+    infill = raster_layer(region, lattice_, angle, s_, min_length_, inset_, reverse_start, &wall);
   }
   dropped_total_ += infill.dropped;
   std::vector<Pass> passes;
@@ -464,7 +478,8 @@ void DepositionBuilder::deposit_layer(int layer, double zb) {
 
   const double angle = angles_[std::size_t(layer) % angles_.size()];
   bool first_of_layer = true;
-  for (const Pass& p : passes_of(region, layer, angle)) {
+  const SliceMask wall = existing_.empty() ? empty_mask_ : slice_of(existing_, k, window_);
+  for (const Pass& p : passes_of(region, wall, layer, angle)) {
     travel_to(p.points.front(), zb);
     for (std::size_t i = 1; i < p.points.size(); ++i) {
       std::string comment;

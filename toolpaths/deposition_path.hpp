@@ -40,7 +40,9 @@ struct DepositionOptions {
   std::vector<double> raster_angles_deg = {0.0, 90.0};
   ContourPass contour = ContourPass::None;
   // How far segment ends stay inside the region along the raster (mm), so that the
-  // bead's end does not spill out. Default: half the bead width.
+  // bead's end does not spill out. Default: half the bead width. An end against material
+  // already there (the existing solid, in the same layer) runs to the region's edge: the
+  // bead's end fuses with that wall instead of leaving notches between the tracks.
   std::optional<double> edge_inset;
   // Clipped raster segments shorter than this (mm, before the inset) are dropped, and so
   // are contour chains shorter than it. Default: the bead width.

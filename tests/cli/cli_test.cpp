@@ -190,6 +190,32 @@ TEST_F(Cli, EveryPlanOfTheArchChannelBlockMillsToTheChannelFloorAndRunsWithinTol
   EXPECT_EQ(plans, 5u) << r.out;
 }
 
+// A repair (issue 16): the worn copy of the flanged hub (2.5 mm gone from half of the
+// flange's top) given as the stock. Every plan starts from it and deposits only what it
+// lacks; one deposits the neighbourhood of the missing region with overfill and mills the
+// top back flat, and every plan offered, run from the worn part on its own simulated
+// controller, makes the hub within tolerance both ways with no alarm.
+TEST_F(Cli, AWornHubIsRepairedByDepositingOnlyWhatItLacksAndEveryPlanRunsWithinTolerance) {
+  const std::string source = HYBRIDCTL_SOURCE_DIR;
+  const Outcome r = run({"dry-run", kFlangedHub, "--machine", kMachine, "--voxel", "0.5", "--stock",
+                         source + "/examples/parts/flanged-hub-worn.stl", "--all", "-o", (dir_ / "dry").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("dry-run     5 of 5 plans ran to the end with no alarm, within tolerance both ways"), std::string::npos)
+      << r.out;
+  // "  2. ((P1 ∪ P17) − P6)": the stock, the deposit near the missing region, a removal.
+  const std::regex local("\\n  (P[0-9]+) +O-AM ded from \\+Z \\(top\\), near the missing 2454 mm");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.out, m, local)) << r.out;
+  const std::regex repair("\\n  [0-9]\\. \\(\\(P1 ∪ " + std::string(m[1]) + "\\) − P[0-9]+\\)  cost");
+  EXPECT_TRUE(std::regex_search(r.out, repair)) << r.out;
+  // Every action after the stock deposits at most the missing 2,454 mm³ and its overfill.
+  const std::regex deposit("\\n     [0-9]\\) P[0-9]+ +[UO]-AM [^\\n]* deposit +([0-9.]+) mm");
+  int deposits = 0;
+  for (auto it = std::sregex_iterator(r.out.begin(), r.out.end(), deposit); it != std::sregex_iterator(); ++it, ++deposits)
+    EXPECT_LT(std::stod((*it)[1]), 2454 * 1.2) << it->str();
+  EXPECT_GE(deposits, 5);
+}
+
 // The bracket's horizontal hole has a roof that no deposit from +Z holds up (it overhangs
 // far past the head's 30 degrees) and that a deposit from -Z, turned over, could only lay
 // under the material already there. The planner proves that no order of its primitives
