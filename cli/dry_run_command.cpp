@@ -10,6 +10,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -97,12 +98,33 @@ class Simulator {
     exited_ = true;
     return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   }
+  // How it ended, when it has: "exited with 3", "killed by signal 6"; empty while it runs.
+  std::string ended() {
+    int status = 0;
+    if (exited_ || ::waitpid(pid_, &status, WNOHANG) != pid_) return exited_ ? "exited" : "";
+    exited_ = true;
+    return WIFEXITED(status) ? "exited with " + std::to_string(WEXITSTATUS(status))
+                             : "killed by signal " + std::to_string(WTERMSIG(status));
+  }
 
  private:
   pid_t pid_ = -1;
   bool exited_ = false;
   FILE* stdout_ = nullptr;
 };
+
+// The last `lines` lines of a text file, each indented; empty when it cannot be read.
+std::string log_tail(const fs::path& file, std::size_t lines) {
+  std::ifstream in(file);
+  std::deque<std::string> last;
+  for (std::string line; std::getline(in, line);) {
+    last.push_back("  | " + line + "\n");
+    if (last.size() > lines) last.pop_front();
+  }
+  std::string out;
+  for (const std::string& l : last) out += l;
+  return out;
+}
 
 // One offered plan run through a fresh simulated controller from the plan's raw stock, in
 // OUT/plan-N; prints as built against as planned and against the design, both ways, and
@@ -145,6 +167,12 @@ bool dry_run_plan(const DryRunArgs& a, const planner::PlanFile& file, int rank, 
   for (const auto& [name, line] : alarms) std::printf("alarm       %s at line %u\n", name.c_str(), unsigned(line));
   if (code != kSuccess) {
     std::printf("result      plan %d STOPPED before its end (exit %d)\n", rank, code);
+    // Why the controller went away, if it did: its own last words (a crash, a sanitizer's
+    // report) would otherwise be lost with the directory.
+    if (const std::string ended = sim.ended(); !ended.empty()) {
+      std::printf("simulator   %s; the end of %s:\n", ended.c_str(), (out / "sim.log").c_str());
+      std::fputs(log_tail(out / "sim.log", 20).c_str(), stdout);
+    }
     return false;
   }
 
