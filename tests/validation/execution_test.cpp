@@ -242,8 +242,9 @@ TEST(Execution, ALayerUnderExistingMaterialIsSkippedAndRejected) {
 
 // The 10 mm cutter cannot enter a 4 mm slot, so the milling leaves it full; the plan then
 // refills the slot it believes empty. Planned against the planned state the head comes down
-// through the material still there; planned against the material present it has nothing to
-// deposit, and the plan is rejected for what the milling could not reach.
+// through the material still there (the deposit keeps a millimetre off the slot's sides, so
+// its rasters do not run up to a wall); planned against the material present it has nothing
+// to deposit, and the plan is rejected for what the milling could not reach.
 TEST(Execution, HeadTravelIsPlannedAgainstTheMaterialTheMillingReallyLeft) {
   Case c(0.5);
   const Solid raw = c.box({{0, 0, 0}, {30, 20, 10}});
@@ -251,7 +252,7 @@ TEST(Execution, HeadTravelIsPlannedAgainstTheMaterialTheMillingReallyLeft) {
   c.file.design = raw;
   const int s = c.stock(raw);
   const int m = c.mill(slot, 1);
-  const int d = c.deposit(c.box({{13, 2, 4}, {17, 18, 10}}));
+  const int d = c.deposit(c.box({{14, 2, 4}, {16, 18, 10}}));
 
   ExecutionOptions planned;
   planned.planned_against = PlannedAgainst::PlannedState;
