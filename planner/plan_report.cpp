@@ -171,6 +171,9 @@ std::string rejected_summary(const PlanningResult& r) {
   for (std::size_t i = 0; i < by_kind.size(); ++i)
     os << (i == 0 ? " (first reasons: " : ", ") << by_kind[i].first << " " << by_kind[i].second
        << (i + 1 == by_kind.size() ? ")" : "");
+  if (r.search.known_to_fail > 0)
+    os << "; " << r.search.known_to_fail << " more passed over unexecuted: they begin with the actions a rejected "
+       << "one failed in";
   os << "\n";
   // One line each for the cheapest: the expression, the cost and the first reason, short; a
   // reason told in full once (candidates that begin the same way fail the same way). The
@@ -343,6 +346,7 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
                    {"generated", r.search.generated},
                    {"exhausted", r.search.exhausted},
                    {"limit_reached", r.search.limit_reached},
+                   {"known_to_fail", r.search.known_to_fail},
                    {"weight", r.search.weight},
                    {"lower_bound", r.search.lower_bound},
                    {"seconds", r.search.seconds}};

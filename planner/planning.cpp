@@ -265,6 +265,24 @@ std::function<bool(const Plan&)> accept_hook(const PlanningOptions& options, Pla
   };
 }
 
+// Plans that begin with the actions a rejected plan failed in, up to the failing action:
+// execution depends only on the actions before (validation/prefix_cache.hpp), so they
+// fail the same way, and the search passes over them without executing them.
+std::function<bool(const Plan&)> known_failure_hook(const PlanningOptions& options, const PlanningResult& r) {
+  if (!options.validate) return {};
+  return [&r](const Plan& plan) {
+    for (const RejectedPlan& known : r.rejected)
+      for (const RejectionReason& reason : known.reasons) {
+        const std::size_t k = std::size_t(reason.action);
+        if (k == 0 || k > plan.steps.size() || k > known.plan.steps.size()) continue;
+        if (std::equal(plan.steps.begin(), plan.steps.begin() + std::ptrdiff_t(k), known.plan.steps.begin(),
+                       [](const PlanStep& a, const PlanStep& b) { return a.primitive == b.primitive; }))
+          return true;
+      }
+    return false;
+  };
+}
+
 // What the nearest state the exploration reached lacks and holds beyond the design: its
 // largest wrong atoms with where they are and what holds them.
 std::string nearest_text(const PlanningResult& r, const Reachability& reach) {
@@ -316,6 +334,7 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
   search.distinct_effects = true;
   search.time_limit = options.search_time;
   search.accept = accept_hook(options, r, validation_seconds);
+  search.known_to_fail = known_failure_hook(options, r);
   search.max_rejected = options.max_rejected;
   r.validated = bool(options.validate);
   r.plans = find_plans(r.problem, search, &r.search);

@@ -229,6 +229,7 @@ void fill_with_weighted(const SearchOptions& options, const Make& make, Clock::t
     st.expanded += local.expanded;
     st.generated += local.generated;
     st.rejected = local.rejected;
+    st.known_to_fail += local.known_to_fail;
     for (Plan& plan : found) {
       plan.exact = false;
       plans.push_back(std::move(plan));
@@ -317,6 +318,8 @@ std::vector<Plan> find_plans(const PlanningProblem& p, const SearchOptions& opti
     // The search runs on the reduced problem; the caller's hook sees plans in its terms.
     SearchOptions inner = options;
     if (options.accept) inner.accept = [&](const Plan& plan) { return options.accept(lift(r, plan)); };
+    if (options.known_to_fail)
+      inner.known_to_fail = [&](const Plan& plan) { return options.known_to_fail(lift(r, plan)); };
     plans = search_plans(r.problem, inner, st, start);
     for (Plan& plan : plans) plan = lift(r, plan);
   }

@@ -99,6 +99,7 @@ struct SearchStats {
   bool limit_reached = false;  // the exact search stopped at a limit before k plans
   double weight = 1.0;  // of the last search that produced plans (1: exact A*)
   std::int64_t rejected = 0;  // goal plans `SearchOptions::accept` turned down
+  std::int64_t known_to_fail = 0;  // goal plans `SearchOptions::known_to_fail` passed over
   // Proven lower bound on the cheapest accepted plan's cost (normalised): its cost when
   // the exact search found it, else the least f = g + h left on the exact search's open
   // list when it stopped (no plan it did not reach can cost less).
@@ -137,6 +138,11 @@ struct SearchOptions {
   // `max_rejected` plans are turned down before the search stops with limit_reached.
   std::function<bool(const Plan&)> accept;
   std::int64_t max_rejected = 50;
+  // When set, asked before `accept`: a plan it names is passed over without being offered
+  // and without counting against max_rejected (one that begins with the actions a plan
+  // turned down failed in: execution depends only on the actions before, so it fails the
+  // same way).
+  std::function<bool(const Plan&)> known_to_fail;
   BlockOrders block_orders = BlockOrders::Every;
   // Plans that do the same thing step by step (each step's tool, setup, mode and the atoms
   // it changes) are one plan to a shop: keep only the first, the cheapest, of them.

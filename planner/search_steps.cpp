@@ -176,6 +176,11 @@ GoalFilter::Verdict GoalFilter::judge(const Plan& plan) {
     ++same_effect_;
     return Pass;
   }
+  if (o_.known_to_fail && o_.known_to_fail(plan)) {
+    ++known_to_fail_;
+    ++st_.known_to_fail;
+    return Pass;
+  }
   if (!o_.accept || o_.accept(plan)) return Take;
   return ++st_.rejected >= o_.max_rejected ? Stop : Pass;
 }

@@ -51,8 +51,8 @@ struct KeyHash {
 };
 
 // What becomes of a plan a search reaches the goal with: returned, passed over (known
-// already, doing what a returned one does, or turned down by SearchOptions::accept), or
-// the search stops (max_rejected plans turned down).
+// already, doing what a returned one does, known to fail, or turned down by
+// SearchOptions::accept), or the search stops (max_rejected plans turned down).
 class GoalFilter {
  public:
   GoalFilter(const PlanningProblem& p, const SearchOptions& o, const std::set<std::vector<int>>& known, SearchStats& st);
@@ -60,7 +60,7 @@ class GoalFilter {
   Verdict judge(const Plan& plan);
   // How many more arrivals at one state than top_k can be of use: one per plan passed over
   // since the search began.
-  std::int64_t passed() const { return st_.rejected - rejected_before_ + same_effect_; }
+  std::int64_t passed() const { return st_.rejected - rejected_before_ + same_effect_ + known_to_fail_; }
 
  private:
   const PlanningProblem& p_;
@@ -70,6 +70,7 @@ class GoalFilter {
   std::int64_t rejected_before_;
   std::set<std::vector<std::uint64_t>> effects_;  // of the plans returned or known (distinct_effects)
   std::int64_t same_effect_ = 0;  // goal plans passed over as doing what one returned does
+  std::int64_t known_to_fail_ = 0;  // goal plans SearchOptions::known_to_fail passed over
 };
 
 }  // namespace hybridctl::planner::detail

@@ -111,6 +111,30 @@ TEST(PaperExample, TheSearchStopsAfterMaxRejectedPlansTurnedDown) {
   EXPECT_TRUE(stats.limit_reached);
 }
 
+// Plans known to fail (they begin as a rejected one did, up to where it failed) are passed
+// over without being offered and without counting against max_rejected: with a limit of
+// one rejection, the search still gets past every plan starting with P1, and returns the
+// two that start with P2.
+TEST(PaperExample, PlansKnownToFailArePassedOverWithoutBeingOfferedOrCounted) {
+  const VoxelProblem vp = paper_example(false);
+  SearchOptions options{3};
+  std::vector<std::string> offered;
+  options.accept = [&](const Plan& p) {
+    offered.push_back(expression(vp.problem, p));
+    return true;
+  };
+  options.known_to_fail = [](const Plan& p) { return p.steps.front().primitive == 0; };
+  options.max_rejected = 1;
+  SearchStats stats;
+  const auto kept = find_plans(vp.problem, options, &stats);
+  ASSERT_EQ(kept.size(), 2u);
+  for (const Plan& p : kept) EXPECT_NE(p.steps.front().primitive, 0) << expression(vp.problem, p);
+  for (const std::string& e : offered) EXPECT_EQ(e.find("((P1 "), std::string::npos) << e;
+  EXPECT_EQ(stats.rejected, 0);
+  EXPECT_GT(stats.known_to_fail, 0);
+  EXPECT_FALSE(stats.limit_reached);
+}
+
 TEST(PaperExample, WithP1AsRawStockOnlyPlansStartingFromItRemain) {
   const VoxelProblem vp = paper_example(true);
   const auto plans = find_plans(vp.problem, {5});
