@@ -267,14 +267,22 @@ std::function<bool(const Plan&)> accept_hook(const PlanningOptions& options, Pla
 
 // Plans that begin with the actions a rejected plan failed in, up to the failing action:
 // execution depends only on the actions before (validation/prefix_cache.hpp), so they
-// fail the same way, and the search passes over them without executing them.
+// fail the same way, and the search passes over them without executing them. The design's
+// core missing after the last deposit is such a failure only for a plan that, like the
+// rejected one, only removes after that action.
 std::function<bool(const Plan&)> known_failure_hook(const PlanningOptions& options, const PlanningResult& r) {
   if (!options.validate) return {};
   return [&r](const Plan& plan) {
+    const auto only_removes_after = [&](std::size_t k) {
+      return std::all_of(plan.steps.begin() + std::ptrdiff_t(k), plan.steps.end(), [&](const PlanStep& s) {
+        return r.problem.primitives[std::size_t(s.primitive)].mode == Mode::Subtractive;
+      });
+    };
     for (const RejectedPlan& known : r.rejected)
       for (const RejectionReason& reason : known.reasons) {
         const std::size_t k = std::size_t(reason.action);
         if (k == 0 || k > plan.steps.size() || k > known.plan.steps.size()) continue;
+        if (reason.kind == "missing_material" && !only_removes_after(k)) continue;
         if (std::equal(plan.steps.begin(), plan.steps.begin() + std::ptrdiff_t(k), known.plan.steps.begin(),
                        [](const PlanStep& a, const PlanStep& b) { return a.primitive == b.primitive; }))
           return true;
