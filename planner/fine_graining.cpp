@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <map>
 #include <optional>
 #include <set>
 
@@ -46,14 +47,33 @@ struct Candidate {
   double cost = 0;
 };
 
+// The neighbourhoods of an atom's part, by reach: the primitives that hold an atom share a
+// few instruments, so each dilation is made once.
+class Neighbourhoods {
+ public:
+  Neighbourhoods(const Solid& part, double tolerance, const IndexBox& domain)
+      : part_(part), tolerance_(tolerance), domain_(domain) {}
+  const Solid& within(double reach) {
+    auto it = near_.find(reach);
+    if (it == near_.end()) it = near_.emplace(reach, geometry::dilate(part_, geometry::Ball{reach + tolerance_}, domain_)).first;
+    return it->second;
+  }
+
+ private:
+  const Solid& part_;
+  double tolerance_;
+  IndexBox domain_;
+  std::map<double, Solid> near_;
+};
+
 // The restriction of `p` to the neighbourhood of `part` that splits `atom` (leaves some
 // of `other` out), or none.
 std::optional<Candidate> restriction(const config::Machine& machine, const Primitive& p, const Solid& atom,
-                                     const Solid& part, const Solid& other, double tolerance, const IndexBox& domain,
+                                     const Solid& part, Neighbourhoods& around_part, const Solid& other,
                                      const Solid* present) {
   const double reach = working_reach(machine, p);
   if (reach <= 0) return std::nullopt;
-  const Solid near = geometry::dilate(part, geometry::Ball{reach + tolerance}, domain);
+  const Solid& near = around_part.within(reach);
   if (subtract(other, near).empty()) return std::nullopt;  // the other part lies within the reach
   Solid region = intersect(p.region, near);
   if (p.mode == Mode::Additive) {
@@ -82,12 +102,9 @@ std::vector<int> violating_atoms(const std::vector<AtomMeasures>& measures) {
 std::string why_unsplit(const config::Machine& machine, const std::vector<Primitive>& primitives,
                         const AtomDecomposition& atoms, int atom, const Solid& design) {
   std::set<std::string> tried;
-  std::set<std::string> skipped;
-  for (std::size_t i = 0; i < primitives.size(); ++i) {
-    if (!atoms.code(atom).test(int(i))) continue;
-    (restrictable(primitives[i]) && working_reach(machine, primitives[i]) > 0 ? tried : skipped)
-        .insert(restrictable(primitives[i]) ? capability_text(machine, primitives[i]) : primitives[i].label);
-  }
+  for (std::size_t i = 0; i < primitives.size(); ++i)
+    if (atoms.code(atom).test(int(i)) && restrictable(primitives[i]) && working_reach(machine, primitives[i]) > 0)
+      tried.insert(capability_text(machine, primitives[i]));
   // Whether any removal that spares the design reaches the outside part at all.
   const Solid outside = subtract(atoms.atom_solid(atom), design);
   std::int64_t reachable = 0;
@@ -128,13 +145,15 @@ FineGraining fine_grain(const config::Machine& machine, const Solid& design, dou
       const Solid atom = atoms.atom_solid(a);
       const Solid inside = intersect(atom, design), outside = subtract(atom, design);
       if (inside.empty() || outside.empty()) continue;
+      Neighbourhoods around_inside(inside, tolerance, atoms.domain()), around_outside(outside, tolerance, atoms.domain());
       std::optional<Candidate> best;
       for (std::size_t i = 0; i < primitives.size(); ++i) {
         if (!atoms.code(a).test(int(i)) || !restrictable(primitives[i])) continue;
         // A deposit cut to what it should make (Ai), a removal to what it should take (Ao).
         const bool deposit = primitives[i].mode == Mode::Additive;
-        std::optional<Candidate> c = restriction(machine, primitives[i], atom, deposit ? inside : outside,
-                                                 deposit ? outside : inside, tolerance, atoms.domain(), present);
+        std::optional<Candidate> c =
+            deposit ? restriction(machine, primitives[i], atom, inside, around_inside, outside, present)
+                    : restriction(machine, primitives[i], atom, outside, around_outside, inside, present);
         if (c && (!best || std::pair{c->exact, -c->cost} > std::pair{best->exact, -best->cost})) best = std::move(c);
       }
       if (!best) continue;
