@@ -34,6 +34,8 @@ struct PlanArgs {
   bool no_validate = false;
   bool no_bands = false;
   bool no_fine_graining = false;
+  bool no_filled = false;
+  bool no_learning = false;
   std::string objective;
   int max_rejected = 200;
   bool report = false;
@@ -66,6 +68,8 @@ int run_plan(const PlanArgs& args) {
   if (!args.no_validate) validation::use_validation(options, machine);
   options.bands = !args.no_bands;
   options.fine_graining = !args.no_fine_graining;
+  options.filled = !args.no_filled;
+  options.learn = !args.no_learning;
   options.objective = objective(args.objective);
   options.max_rejected = args.max_rejected;
   ProgressBar bar("planning");
@@ -165,6 +169,12 @@ void add_plan_command(CLI::App& app, Runner& runner) {
   cmd->add_flag("--no-fine-graining", args->no_fine_graining,
                 "Do not split atoms that straddle the design with primitives restricted to their neighbourhood "
                 "(iterative fine-graining, docs/bands.md): for comparison and benchmarks");
+  cmd->add_flag("--no-filled", args->no_filled,
+                "Do not offer filled deposits (a head's overfill with holes and overhangs filled solid, to be milled "
+                "back, docs/support.md): for comparison and benchmarks");
+  cmd->add_flag("--no-learning", args->no_learning,
+                "Do not correct the search from what rejected candidates' execution showed the primitives do not do "
+                "(docs/validation.md): for comparison and benchmarks");
   add_objective_option(cmd, args->objective);
   cmd->add_option("--max-rejected", args->max_rejected,
                   "How many candidate plans validation may turn down before the search gives up")

@@ -7,6 +7,7 @@
 #include "geometry/memory_estimate.hpp"
 #include "instruments/cutter.hpp"
 #include "planner/bands.hpp"
+#include "planner/filled_deposits.hpp"
 #include "planner/machine_primitives.hpp"
 
 namespace hybridctl::planner {
@@ -61,7 +62,8 @@ double scratch_grid_voxels(const Box3& region, const config::Machine& m, double 
 PlanningMemory planning_memory(const Box3& part_bounds, const config::Machine& m, double h, double tolerance) {
   const Box3 region = planning_region(m, part_bounds, tolerance);
   PlanningMemory mem;
-  mem.primitives = machine_primitive_count(m) + max_banded_primitive_count(m) + kMaxFineGrainedPrimitives;
+  mem.primitives = machine_primitive_count(m) + max_banded_primitive_count(m) + max_filled_primitive_count(m) +
+                   kMaxFineGrainedPrimitives;
   mem.voxel_set = geometry::solid_bytes(region, h, 2);
   // Design, tolerance core and hull, the plan outcomes (top_k) and two operands of a CSG step.
   mem.other_voxel_sets = 5 + std::size_t(std::max(1, m.planning.top_k));

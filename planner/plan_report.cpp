@@ -175,6 +175,7 @@ std::string rejected_summary(const PlanningResult& r) {
     os << "; " << r.search.known_to_fail << " more passed over unexecuted: they begin with the actions a rejected "
        << "one failed in";
   os << "\n";
+  if (!r.learned.empty()) os << "learned     " << learned_text(r) << "\n";
   // One line each for the cheapest: the expression, the cost and the first reason, short; a
   // reason told in full once (candidates that begin the same way fail the same way). The
   // rest are counted; plan.json has them all.
@@ -349,7 +350,8 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
                    {"known_to_fail", r.search.known_to_fail},
                    {"weight", r.search.weight},
                    {"lower_bound", r.search.lower_bound},
-                   {"seconds", r.search.seconds}};
+                   {"seconds", r.search.seconds},
+                   {"rounds", r.search_rounds}};
 
   const json plans = plans_json(r);
   doc["plans"] = plans;
@@ -357,6 +359,15 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
   doc["estimates_off"] = r.estimates_off;
   doc["validated"] = r.validated;
   doc["rejected"] = rejected_json(r);
+  json learned = json::array();
+  for (const Shortfall& s : r.learned) {
+    const AtomMeasures& m = r.measures[std::size_t(s.atom)];
+    learned.push_back({{"primitive", r.problem.primitives[std::size_t(s.primitive)].name},
+                       {"atom", s.atom},
+                       {"volume_mm3", s.volume},
+                       {"centroid", {m.centroid.x, m.centroid.y, m.centroid.z}}});
+  }
+  doc["learned"] = learned;
   json timings = json::object();
   for (const auto& [phase, seconds] : r.timings) timings[phase] = seconds;
   doc["timings_s"] = timings;
@@ -436,7 +447,7 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
        << "\n";
   os << "verdict     "
      << (r.verdict.manufacturable ? "manufacturable"
-         : r.search.limit_reached && !r.verdict.decided_without_search ? "UNDECIDED"
+         : (r.search.limit_reached || !r.learned.empty()) && !r.verdict.decided_without_search ? "UNDECIDED"
                                                                         : "NOT manufacturable")
      << ": " << r.verdict.summary
      << "\n";

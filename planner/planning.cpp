@@ -9,6 +9,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <set>
 
 #include "common/error.hpp"
 #include "common/number_text.hpp"
@@ -17,6 +18,7 @@
 #include "instruments/elements.hpp"
 #include "planner/bands.hpp"
 #include "planner/deposit_reach.hpp"
+#include "planner/filled_deposits.hpp"
 #include "planner/fine_graining.hpp"
 #include "planner/memory_estimate.hpp"
 #include "planner/repair_primitives.hpp"
@@ -118,9 +120,16 @@ void add_primitives(const config::Machine& machine, const PlanningOptions& optio
   for (std::size_t i = 0; i < r.primitives.size(); ++i) r.primitives[i].name = "P" + std::to_string(i + 1);
   // In the objective's units before the bands weigh milling against depositing.
   for (Primitive& p : r.primitives) p.cost_per_mm3 = objective_per_mm3(machine, r.objective, p);
+  // From the whole-part O-AMs (not the bands'); numbered after the bands.
+  std::vector<Primitive> filled;
+  if (options.filled) filled = filled_primitives(machine, r.design, r.domain, r.primitives);
   if (options.bands) {
     for (Primitive& p : banded_primitives(machine, r.design, r.tolerance, r.domain, r.primitives))
       r.primitives.push_back(std::move(p));
+  }
+  for (Primitive& p : filled) {
+    p.name = "P" + std::to_string(r.primitives.size() + 1);
+    r.primitives.push_back(std::move(p));
   }
   if (stocks.size() == 1) {
     // A repair: deposits near what the stock lacks, milled back where the head reaches.
@@ -245,22 +254,46 @@ PlanningProblem symbolic_problem(const PlanningResult& r, const config::Machine&
   return p;
 }
 
+// What the rejections of one search taught, before the next search takes it in.
+struct Learning {
+  std::vector<Shortfall> pending;  // not yet taken out of the problem's primitives
+  // Candidates proven by execution: a search started again finds them again, and
+  // execution would only repeat itself.
+  std::set<std::vector<int>> proven;
+};
+
+std::vector<int> primitives_of(const Plan& plan) {
+  std::vector<int> sequence;
+  for (const PlanStep& s : plan.steps) sequence.push_back(s.primitive);
+  return sequence;
+}
+
 // The search's accept hook from PlanningOptions::validate: rejected plans are kept with
-// their reasons (once each, as a weighted search may find them again), and the time the
-// validation takes is counted apart from the search's.
-std::function<bool(const Plan&)> accept_hook(const PlanningOptions& options, PlanningResult& r, double& seconds) {
+// their reasons (once each, as a weighted search may find them again), their shortfalls
+// wait in `learning` for the next round, and the time the validation takes is counted
+// apart from the search's.
+std::function<bool(const Plan&)> accept_hook(const PlanningOptions& options, PlanningResult& r, double& seconds,
+                                             Learning& learning) {
   if (!options.validate) return {};
-  return [&options, &r, &seconds](const Plan& plan) {
-    const auto same_actions = [&plan](const RejectedPlan& known) {
-      return std::equal(known.plan.steps.begin(), known.plan.steps.end(), plan.steps.begin(), plan.steps.end(),
-                        [](const PlanStep& a, const PlanStep& b) { return a.primitive == b.primitive; });
-    };
+  return [&options, &r, &seconds, &learning](const Plan& plan) {
+    const std::vector<int> sequence = primitives_of(plan);
+    if (learning.proven.count(sequence)) return true;
+    const auto same_actions = [&sequence](const RejectedPlan& known) { return primitives_of(known.plan) == sequence; };
     if (std::any_of(r.rejected.begin(), r.rejected.end(), same_actions)) return false;
     const auto start = std::chrono::steady_clock::now();
-    std::vector<RejectionReason> reasons = options.validate(r, plan);
+    CandidateCheck check = options.validate(r, plan);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (reasons.empty()) return true;
-    r.rejected.push_back({plan, std::move(reasons)});
+    if (check.reasons.empty()) {
+      learning.proven.insert(sequence);
+      return true;
+    }
+    for (const Shortfall& s : check.shortfalls) {
+      const AtomSet& known = r.problem.primitives[std::size_t(s.primitive)].falls_short;
+      const bool learned = !known.words().empty() && known.test(s.atom);
+      if (!learned && std::find(learning.pending.begin(), learning.pending.end(), s) == learning.pending.end())
+        learning.pending.push_back(s);
+    }
+    r.rejected.push_back({plan, std::move(check.reasons)});
     return false;
   };
 }
@@ -325,6 +358,31 @@ std::string nearest_text(const PlanningResult& r, const Reachability& reach) {
   return s;
 }
 
+}  // namespace
+
+std::string learned_text(const PlanningResult& r) {
+  if (r.learned.empty()) return {};
+  std::set<int> primitives;
+  double volume = 0;
+  const Shortfall* largest = &r.learned.front();
+  for (const Shortfall& s : r.learned) {
+    primitives.insert(s.primitive);
+    volume += s.volume;
+    if (s.volume > largest->volume) largest = &s;
+  }
+  const AtomMeasures& m = r.measures[std::size_t(largest->atom)];
+  char where[96];
+  std::snprintf(where, sizeof where, "%.3g mm\u00B3 around (%.1f, %.1f, %.1f) mm", m.volume, m.centroid.x, m.centroid.y,
+                m.centroid.z);
+  return "executed candidates showed " + std::to_string(primitives.size()) + " primitive" +
+         (primitives.size() == 1 ? "" : "s") + " falling short of the model on " + std::to_string(r.learned.size()) +
+         " atom" + (r.learned.size() == 1 ? "" : "s") + " (" + trimmed_number(volume, 1) + " mm\u00B3; largest " + where +
+         ", by " + r.problem.primitives[std::size_t(largest->primitive)].name + "), taken out of them over " +
+         std::to_string(r.search_rounds) + " searches";
+}
+
+namespace {
+
 std::string unreachable_text(const PlanningResult& r, const Reachability& reach) {
   return "no sequence of these primitives makes the design: none of the " + std::to_string(reach.states) +
          " states they reach (costs aside, each primitive any number of times) is within tolerance. The nearest " +
@@ -341,17 +399,51 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
   search.block_orders = BlockOrders::Cheapest;
   search.distinct_effects = true;
   search.time_limit = options.search_time;
-  search.accept = accept_hook(options, r, validation_seconds);
+  Learning learning;
+  search.accept = accept_hook(options, r, validation_seconds, learning);
   search.known_to_fail = known_failure_hook(options, r);
   search.max_rejected = options.max_rejected;
+  // A rejection that showed a primitive falling short stops the search: the next one runs
+  // on the problem without what the primitive does not do (planner/shortfall.hpp).
+  if (options.learn)
+    search.interrupt = [&learning, &r]() { return !learning.pending.empty() && r.search_rounds < kMaxLearningRounds; };
   r.validated = bool(options.validate);
-  r.plans = find_plans(r.problem, search, &r.search);
+  const auto started = std::chrono::steady_clock::now();
+  SearchStats total;
+  for (;;) {
+    ++r.search_rounds;
+    SearchStats round;
+    r.plans = find_plans(r.problem, search, &round);
+    total.expanded += round.expanded;
+    total.generated += round.generated;
+    total.rejected += round.rejected;
+    total.known_to_fail += round.known_to_fail;
+    total.seconds += round.seconds;
+    total.exhausted = round.exhausted;
+    total.limit_reached = round.limit_reached;
+    total.weight = round.weight;
+    total.lower_bound = round.lower_bound;
+    if (!round.interrupted) break;
+    for (const Shortfall& s : learning.pending) {
+      AtomSet& short_of = r.problem.primitives[std::size_t(s.primitive)].falls_short;
+      if (short_of.words().empty()) short_of = AtomSet(int(r.problem.atoms.size()));
+      short_of.set(s.atom);
+      r.learned.push_back(s);
+    }
+    learning.pending.clear();
+    // The rounds share the budgets: turned-down plans and seconds.
+    search.max_rejected = std::max<std::int64_t>(1, options.max_rejected - total.rejected);
+    if (options.search_time > 0)
+      search.time_limit = std::max(
+          0.05, options.search_time - std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+  }
+  r.search = total;
   std::string undecided_hint;
   if (r.plans.empty() && r.search.limit_reached && !r.verdict.decided_without_search) {
     // The search stopped without a plan: maybe none exists. Exploring what the primitives
     // reach at all, costs aside, can prove it.
     const Reachability reach = explore_reachable(r.problem);
-    if (reach.complete && !reach.goal) {
+    if (reach.complete && !reach.goal && r.learned.empty()) {
       r.search.limit_reached = false;
       r.search.exhausted = true;
       r.verdict.manufacturable = false;
@@ -365,11 +457,16 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
                        "nearest " + nearest_text(r, reach);
   }
   progress("search", 1);
+  if (r.plans.empty() && !r.verdict.decided_without_search && !r.learned.empty())
+    undecided_hint += "; " + learned_text(r) + ", which may also rule out plans that would work";
   if (r.plans.empty() && !r.verdict.decided_without_search) {
     r.verdict.manufacturable = false;
     r.verdict.summary = !r.rejected.empty()
                             ? "every candidate plan failed when executed (" + std::to_string(r.rejected.size()) +
-                                  " rejected" + (r.search.limit_reached ? ", the search stopped at its limit" : "") + ")"
+                                  " rejected" + (r.search.limit_reached ? ", the search stopped at its limit" : "") + ")" +
+                                  (r.learned.empty() ? std::string()
+                                                     : "; " + learned_text(r) +
+                                                           ", which may also rule out plans that would work")
                         : r.search.limit_reached
                             ? "undecided: no plan found within the search limits (" + std::to_string(r.search.expanded) +
                                   " states expanded, weighted A* included); no atom rules the part out, but the "
@@ -445,12 +542,15 @@ AtomSet step_region(const PlanningResult& r, const Plan& plan, std::size_t step)
   AtomSet roi(r.atoms.atom_count());
   for (std::size_t s = 0; s <= step && s < plan.steps.size(); ++s) {
     const PrimitiveSpec& prim = r.problem.primitives[std::size_t(plan.steps[s].primitive)];
+    // As the search applies it (search_steps.hpp): once begun, not what it falls short on.
+    const auto& short_of = prim.falls_short.words();
+    const bool begun = s > 0;
     for (std::size_t w = 0; w < state.words().size(); ++w) {
-      const std::uint64_t changed = prim.mode == Mode::Additive ? prim.atoms.words()[w] & ~state.words()[w]
-                                                                : prim.atoms.words()[w] & state.words()[w];
+      const std::uint64_t does =
+          begun && w < short_of.size() ? prim.atoms.words()[w] & ~short_of[w] : prim.atoms.words()[w];
+      const std::uint64_t changed = prim.mode == Mode::Additive ? does & ~state.words()[w] : does & state.words()[w];
       if (s == step) roi.words()[w] = changed;
-      state.words()[w] = prim.mode == Mode::Additive ? state.words()[w] | prim.atoms.words()[w]
-                                                     : state.words()[w] & ~prim.atoms.words()[w];
+      state.words()[w] = prim.mode == Mode::Additive ? state.words()[w] | does : state.words()[w] & ~changed;
     }
   }
   return roi;

@@ -17,6 +17,7 @@
 #include "planner/machine_primitives.hpp"
 #include "planner/rejection.hpp"
 #include "planner/search.hpp"
+#include "planner/shortfall.hpp"
 
 namespace hybridctl::planner {
 
@@ -28,6 +29,11 @@ struct PrimitiveFile {
 };
 
 struct PlanningResult;
+
+// How often the search starts again on a problem corrected by shortfalls: each round
+// costs a search, and a model still wrong after this many corrections is left to the
+// rejections alone.
+inline constexpr int kMaxLearningRounds = 8;
 
 struct PlanningOptions {
   // Unset values (<= 0, or top_k 0) take the machine file's planning defaults.
@@ -47,6 +53,12 @@ struct PlanningOptions {
   // Iterative fine-graining (planner/fine_graining.hpp): split atoms that straddle the
   // design with primitives restricted to their neighbourhood.
   bool fine_graining = true;
+  // Filled deposits (planner/filled_deposits.hpp): overfill with holes and overhangs filled
+  // solid, where milling can open them again.
+  bool filled = true;
+  // Shortfalls that validation reports correct the problem and restart the search
+  // (planner/shortfall.hpp); false: rejections only pass plans over.
+  bool learn = true;
   // What the search minimises (planner/costing.hpp); unset: the machine file's.
   std::optional<config::Objective> objective;
   // Raw stocks as files (STL or .vdb on the plan's grid) in the part's frame: a casting, a
@@ -61,7 +73,10 @@ struct PlanningOptions {
   // design, primitives, atoms, problem). No reasons: the plan is kept; reasons: it is
   // recorded in PlanningResult::rejected and the search goes on to the next candidate,
   // until top_k plans are kept, the plans run out, or `max_rejected` were turned down.
-  std::function<std::vector<RejectionReason>(const PlanningResult&, const Plan&)> validate;
+  // Shortfalls with the reasons (planner/shortfall.hpp) correct the problem: each takes its
+  // atom out of its primitive, and the search starts again on the corrected problem, at
+  // most kMaxLearningRounds times.
+  std::function<CandidateCheck(const PlanningResult&, const Plan&)> validate;
   // After the search: an offered plan's actions' cycle times in minutes from their
   // toolpaths (validation records them as it proves plans; empty: unknown). Where they
   // are far from the estimate the plans are ranked by them (planner/toolpath_rank.hpp).
@@ -91,6 +106,10 @@ struct PlanningResult {
   std::vector<Plan> plans;
   std::vector<Deviation> deviations;  // one per plan: its outcome against the design
   std::vector<RejectedPlan> rejected;  // candidates validation turned down, in the order found
+  // What execution showed the primitives do not do (taken out of `problem`'s primitives),
+  // in the order learned, and how many searches ran (1 + the restarts they caused).
+  std::vector<Shortfall> learned;
+  int search_rounds = 0;
   bool validated = false;              // the plans were validated (PlanningOptions::validate)
   SearchStats search;
   FineGraining fine_graining;  // what fine-graining added, and what it could not split
@@ -113,6 +132,10 @@ struct PlanningResult {
 // a .vdb primitive on another lattice).
 PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& part_name,
                          const config::Machine& machine, const PlanningOptions& options);
+
+// What execution showed the primitives do not do (PlanningResult::learned), in a phrase:
+// how many primitives and atoms, the largest, and the searches; empty when nothing was learned.
+std::string learned_text(const PlanningResult& result);
 
 // The solid a plan leaves: the union of the atoms in its final state.
 geometry::Solid plan_outcome(const PlanningResult& result, const Plan& plan);

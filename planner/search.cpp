@@ -117,7 +117,7 @@ void Search::expand(int id) {
     if (o_.block_orders == BlockOrders::Cheapest && !in_block_order(p_, last, i)) continue;
     AtomSet next;
     double volume = 0;
-    if (!apply(p_, nodes_[std::size_t(id)].state, i, next, volume)) continue;
+    if (!apply(p_, nodes_[std::size_t(id)].state, i, next, volume, id == 0)) continue;
     Node child;
     child.parent = id;
     child.primitive = i;
@@ -230,6 +230,7 @@ void fill_with_weighted(const SearchOptions& options, const Make& make, Clock::t
     st.generated += local.generated;
     st.rejected = local.rejected;
     st.known_to_fail += local.known_to_fail;
+    st.interrupted = local.interrupted;
     for (Plan& plan : found) {
       plan.exact = false;
       plans.push_back(std::move(plan));
@@ -237,6 +238,7 @@ void fill_with_weighted(const SearchOptions& options, const Make& make, Clock::t
     std::stable_sort(plans.begin() + std::ptrdiff_t(exact), plans.end(), by_cost);
     if (int(plans.size() - exact) > slots) plans.resize(exact + std::size_t(slots));
     if (!found.empty()) st.weight = weights[k];
+    if (st.interrupted) break;
   }
 }
 
@@ -259,7 +261,7 @@ std::vector<Plan> exact_then_weighted(const SearchOptions& options, const Make& 
     for (Plan& plan : plans) plan.exact = false;
   } else if (int(plans.size()) < options.top_k && !exact.stopped_at_limit()) {
     st.exhausted = true;
-  } else if (int(plans.size()) < options.top_k) {
+  } else if (int(plans.size()) < options.top_k && !st.interrupted) {
     fill_with_weighted(options, make, start, plans, st);
   }
   // Gaps against the best proven lower bound on the cheapest accepted plan.
@@ -281,7 +283,7 @@ std::vector<Plan> exact_then_weighted(const SearchOptions& options, const Make& 
 bool backwards(const PlanningProblem& p, const SearchOptions& options) {
   if (options.direction != SearchDirection::Auto) return options.direction == SearchDirection::Backward;
   for (const PrimitiveSpec& prim : p.primitives)
-    if (prim.blocked_by || prim.footing) return false;
+    if (prim.blocked_by || prim.footing || !prim.falls_short.words().empty()) return false;
   for (const AtomSpec& atom : p.atoms)
     if (!atom.must_in && !atom.must_out) return false;
   return true;

@@ -50,6 +50,9 @@ struct PrimitiveSpec {
   // Additive only: in a state that holds material, an atom of the first layer it would
   // deposit needs a carrier present; null: nothing limits it.
   std::shared_ptr<const DepositFooting> footing;
+  // Atoms the action does not change once the plan has begun (in a state that holds
+  // material), as executed candidates showed (planner/shortfall.hpp); empty: none.
+  AtomSet falls_short;
 };
 
 // What changing between two consecutive actions costs (in the problem's cost units, before
@@ -100,6 +103,7 @@ struct SearchStats {
   double weight = 1.0;  // of the last search that produced plans (1: exact A*)
   std::int64_t rejected = 0;  // goal plans `SearchOptions::accept` turned down
   std::int64_t known_to_fail = 0;  // goal plans `SearchOptions::known_to_fail` passed over
+  bool interrupted = false;  // SearchOptions::interrupt stopped it after a plan was turned down
   // Proven lower bound on the cheapest accepted plan's cost (normalised): its cost when
   // the exact search found it, else the least f = g + h left on the exact search's open
   // list when it stopped (no plan it did not reach can cost less).
@@ -143,6 +147,10 @@ struct SearchOptions {
   // turned down failed in: execution depends only on the actions before, so it fails the
   // same way).
   std::function<bool(const Plan&)> known_to_fail;
+  // When set, asked after `accept` turned a plan down: true stops the whole search there
+  // (SearchStats::interrupted), weighted searches included, so that the caller may search
+  // again on a problem it corrected from what the rejection showed.
+  std::function<bool()> interrupt;
   BlockOrders block_orders = BlockOrders::Every;
   // Plans that do the same thing step by step (each step's tool, setup, mode and the atoms
   // it changes) are one plan to a shop: keep only the first, the cheapest, of them.

@@ -77,6 +77,7 @@ std::vector<int> group_atoms(const PlanningProblem& p, const std::vector<int>& k
     for (std::size_t k = 0; k < kept.size(); ++k) {
       const PrimitiveSpec& prim = p.primitives[std::size_t(kept[k])];
       if (prim.atoms.test(int(a))) key[k / 64] |= std::uint64_t{1} << (k % 64);
+      if (!prim.falls_short.words().empty()) key.push_back(prim.falls_short.test(int(a)) ? 3 : 2);
       if (!prim.footing || a >= prim.footing->kind.size()) continue;
       const bool needs = prim.footing->kind[a] == DepositFooting::NeedsCarrier;
       key.push_back(needs);
@@ -154,6 +155,7 @@ void reduce_primitives(const PlanningProblem& p, const std::vector<int>& group, 
   for (const int i : r.primitive) {
     PrimitiveSpec prim = p.primitives[std::size_t(i)];
     prim.atoms = mapped(prim.atoms, group, groups);
+    if (!prim.falls_short.words().empty()) prim.falls_short = mapped(prim.falls_short, group, groups);
     if (prim.blocked_by) {
       Reach& reach = reaches[prim.blocked_by.get()];
       if (!reach) reach = mapped_reach(*prim.blocked_by, group, groups);

@@ -35,10 +35,10 @@ bool blocked(const std::vector<AtomSet>& blocked_by, const AtomSet& state, const
 }
 
 // Whether an atom of the first layer in `deposited` has nothing to carry it: no plate (the
-// state holds material, so the plan did not start here) and no carrier present.
+// plan did not start with this action: a stock milled away entirely leaves none either)
+// and no carrier present.
 bool floating(const DepositFooting& footing, const AtomSet& state, const std::vector<std::uint64_t>& deposited) {
   const auto& s = state.words();
-  if (std::all_of(s.begin(), s.end(), [](std::uint64_t w) { return w == 0; })) return false;
   for (std::size_t w = 0; w < deposited.size(); ++w)
     for (std::uint64_t b = deposited[w]; b; b &= b - 1) {
       const std::size_t atom = w * 64 + std::size_t(std::countr_zero(b));
@@ -55,7 +55,7 @@ bool floating(const DepositFooting& footing, const AtomSet& state, const std::ve
 
 // The state after applying primitive `i`, and the volume it really changes; false when
 // it changes nothing or cannot be taken in this state.
-bool apply(const PlanningProblem& p, const AtomSet& state, int i, AtomSet& next, double& volume) {
+bool apply(const PlanningProblem& p, const AtomSet& state, int i, AtomSet& next, double& volume, bool first) {
   const PrimitiveSpec& prim = p.primitives[std::size_t(i)];
   const auto& s = state.words();
   const auto& a = prim.atoms.words();
@@ -63,19 +63,22 @@ bool apply(const PlanningProblem& p, const AtomSet& state, int i, AtomSet& next,
   next = state;
   auto& n = next.words();
   bool any = false;
+  const auto& short_of = prim.falls_short.words();
+  const bool begun = !first && !short_of.empty();
   for (std::size_t w = 0; w < s.size(); ++w) {
+    const std::uint64_t does = begun && w < short_of.size() ? a[w] & ~short_of[w] : a[w];
     if (prim.mode == Mode::Additive) {
-      changed[w] = a[w] & ~s[w];
-      n[w] = s[w] | a[w];
+      changed[w] = does & ~s[w];
+      n[w] = s[w] | does;
     } else {
-      changed[w] = a[w] & s[w];
-      n[w] = s[w] & ~a[w];
+      changed[w] = does & s[w];
+      n[w] = s[w] & ~does;
     }
     any = any || changed[w];
   }
   if (!any) return false;
   if (prim.mode == Mode::Additive && prim.blocked_by && blocked(*prim.blocked_by, state, changed)) return false;
-  if (prim.mode == Mode::Additive && prim.footing && floating(*prim.footing, state, changed)) return false;
+  if (prim.mode == Mode::Additive && prim.footing && !first && floating(*prim.footing, state, changed)) return false;
   volume = volume_of_bits(p, changed);
   return true;
 }
@@ -136,7 +139,7 @@ bool simulate(const PlanningProblem& p, const std::vector<int>& sequence, Plan& 
     AtomSet next;
     double volume = 0;
     // A plan ends where it first reaches the goal.
-    if ((last >= 0 && is_goal(p, state)) || !apply(p, state, i, next, volume)) return false;
+    if ((last >= 0 && is_goal(p, state)) || !apply(p, state, i, next, volume, last < 0)) return false;
     const double cost = (p.primitives[std::size_t(i)].cost_per_mm3 * volume + fixed_cost(p, last, i)) / p.normaliser;
     plan.steps.push_back({i, volume, cost});
     plan.cost += cost;
@@ -182,7 +185,12 @@ GoalFilter::Verdict GoalFilter::judge(const Plan& plan) {
     return Pass;
   }
   if (!o_.accept || o_.accept(plan)) return Take;
-  return ++st_.rejected >= o_.max_rejected ? Stop : Pass;
+  ++st_.rejected;
+  if (o_.interrupt && o_.interrupt()) {
+    st_.interrupted = true;
+    return Stop;
+  }
+  return st_.rejected >= o_.max_rejected ? Stop : Pass;
 }
 
 }  // namespace detail
@@ -226,7 +234,7 @@ Reachability explore_reachable(const PlanningProblem& p, std::int64_t max_states
       if (!allowed(p, i, first, no_uses)) continue;
       AtomSet next;
       double volume = 0;
-      if (!apply(p, state, i, next, volume) || seen.count(next)) continue;
+      if (!apply(p, state, i, next, volume, first) || seen.count(next)) continue;
       if (std::int64_t(seen.size()) >= max_states) return r;
       ++r.states;
       const double w = wrong(next);
@@ -262,7 +270,7 @@ std::vector<Plan> enumerate_plans(const PlanningProblem& p, std::size_t limit) {
       if (!allowed(p, i, last < 0, uses)) continue;
       AtomSet next;
       double volume = 0;
-      if (!apply(p, state, i, next, volume)) continue;
+      if (!apply(p, state, i, next, volume, last < 0)) continue;
       const double step = (p.primitives[std::size_t(i)].cost_per_mm3 * volume + fixed_cost(p, last, i)) / p.normaliser;
       current.steps.push_back({i, volume, step});
       ++uses[std::size_t(i)];

@@ -13,8 +13,8 @@ namespace hybridctl::planner::detail {
 
 // The state after applying primitive `i`, and the volume it really changes; false when
 // it changes nothing or cannot be taken in this state (a deposit out of the head's reach,
-// or with nothing to carry its first layer).
-bool apply(const PlanningProblem& p, const AtomSet& state, int i, AtomSet& next, double& volume);
+// or with nothing to carry its first layer). `first`: the plan's first action (on the plate).
+bool apply(const PlanningProblem& p, const AtomSet& state, int i, AtomSet& next, double& volume, bool first);
 
 // The fixed costs of `next` after `previous` (-1: `next` starts the plan), not normalised.
 double fixed_cost(const PlanningProblem& p, int previous, int next);

@@ -87,7 +87,7 @@ PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions option
                      [](int p, const planner::PlanFileAction& a) { return p == a.primitive; }) &&
           (!failed.only_if_removals_follow ||
            std::all_of(candidate.actions.begin() + std::ptrdiff_t(failed.primitives.size()), candidate.actions.end(), removes)))
-        return failed.reasons;
+        return planner::CandidateCheck{failed.reasons};
     try {
       Execution run = execute_plan(*state->file, candidate, machine, state->options, state->cache.get());
       if (run.stopped_after > 0) {
@@ -100,11 +100,14 @@ PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions option
         for (const planner::PlanFileAction& a : candidate.actions) key.push_back(a.primitive);
         (*times)[key] = action_minutes(run, machine);
       }
-      return std::move(run.reasons);
+      if (run.proven()) return planner::CandidateCheck{};
+      const std::size_t executed = run.stopped_after > 0 ? std::size_t(run.stopped_after) : plan.steps.size();
+      std::vector<planner::Shortfall> shortfalls = planner::find_shortfalls(r.problem, r.atoms, plan, executed, run.as_built);
+      return planner::CandidateCheck{std::move(run.reasons), std::move(shortfalls)};
     } catch (const InputError& e) {
       // The plan cannot be written for this machine (a move beyond its envelope, ...): it
       // makes no part, and the search goes on.
-      return std::vector<planner::RejectionReason>{{"not_exportable", 0, 0, e.what(), std::nullopt}};
+      return planner::CandidateCheck{{{"not_exportable", 0, 0, e.what(), std::nullopt}}};
     }
   };
 }

@@ -1,7 +1,8 @@
 #pragma once
 // Validation by execution as the planner's hook (PlanningOptions::validate): every
 // candidate plan the search finds is exported and executed (validation/execution.hpp)
-// before it is offered; its reasons, if any, reject it and the search goes on.
+// before it is offered; its reasons, if any, reject it and the search goes on, and what
+// its execution left short of the plan's atoms (planner/shortfall.hpp) corrects the search.
 //
 //   planner::PlanningOptions options;
 //   options.validate = validation::plan_validator(machine);
@@ -19,7 +20,7 @@
 
 namespace hybridctl::validation {
 
-using PlanCheck = std::function<std::vector<planner::RejectionReason>(const planner::PlanningResult&, const planner::Plan&)>;
+using PlanCheck = std::function<planner::CandidateCheck(const planner::PlanningResult&, const planner::Plan&)>;
 
 // Per proven candidate (its primitives in order), each action's cycle time in minutes as
 // `gcode check` estimates it from the action's own program (0 for one that makes no G-code).

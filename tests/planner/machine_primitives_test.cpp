@@ -89,16 +89,16 @@ TEST(MachinePrimitives, EveryRemovalRegionEqualsItsDefinitionFromEverySide) {
 
 // The memory check counts every primitive the machine offers over all its setups, and the
 // banded ones it may add (two levels, each on one setup here: its deposit and its cutter),
-// and the fine-grained ones (at most kMaxFineGrainedPrimitives), and says what takes the
-// memory when a problem does not fit.
+// the filled deposits (one per head with an O-AM and setup), and the fine-grained ones (at
+// most kMaxFineGrainedPrimitives), and says what takes the memory when a problem does not fit.
 TEST(MachinePrimitives, TheMemoryCheckCountsEveryPrimitiveOfEverySetup) {
   const config::Machine machine = config::parse_machine(kMachine, "six-sided.yaml");
   config::Machine one_setup = machine;
   one_setup.setups.resize(1);
   const Box3 part{{0, 0, 0}, {10, 10, 8}};
   const PlanningMemory six = planning_memory(part, machine, 0.5, 0.25), one = planning_memory(part, one_setup, 0.5, 0.25);
-  EXPECT_EQ(six.primitives, 1 + 6 * 1 + 6 * 4 * 2 + 2 * (1 + 1) + kMaxFineGrainedPrimitives);
-  EXPECT_EQ(one.primitives, 1 + 1 * 1 + 1 * 4 * 2 + 2 * (1 + 1) + kMaxFineGrainedPrimitives);
+  EXPECT_EQ(six.primitives, 1 + 6 * 1 + 6 * 4 * 2 + 2 * (1 + 1) + 6 * 1 + kMaxFineGrainedPrimitives);
+  EXPECT_EQ(one.primitives, 1 + 1 * 1 + 1 * 4 * 2 + 2 * (1 + 1) + 1 * 1 + kMaxFineGrainedPrimitives);
   EXPECT_GT(six.total(), one.total());
   EXPECT_EQ(six.total() - one.total(), double(six.primitives - one.primitives) * six.voxel_set);
   try {
@@ -106,7 +106,7 @@ TEST(MachinePrimitives, TheMemoryCheckCountsEveryPrimitiveOfEverySetup) {
     FAIL() << "a 1 MiB budget fits";
   } catch (const InputError& e) {
     const std::string message = e.what();
-    EXPECT_NE(message.find("planning mushroom.stl at 0.5 mm (75 primitives and 10 other voxel sets"), std::string::npos) << message;
+    EXPECT_NE(message.find("planning mushroom.stl at 0.5 mm (81 primitives and 10 other voxel sets"), std::string::npos) << message;
     EXPECT_NE(message.find("over the budget of 1.0 MiB"), std::string::npos) << message;
   }
   EXPECT_NO_THROW(check_planning_memory(part, machine, 0.5, 0.25, std::uint64_t(six.total()) + 1, "mushroom.stl"));

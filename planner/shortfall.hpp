@@ -1,0 +1,53 @@
+#pragma once
+// What executing a candidate plan shows about the symbolic model (docs/validation.md,
+// "Learning from rejected candidates"). The model says an additive action deposits all of
+// its primitive's atoms that are missing and a subtractive one clears all of its atoms that
+// are present; the toolpaths and the material simulation sometimes cannot (a layer under
+// material the head cannot reach past, a region no pass covers, a bead that falls off an
+// edge). When an atom the plan needs is not as planned after the action that last changed
+// it, that action's primitive fell short on that atom. The planner then takes the atom out
+// of the primitive and searches again, instead of offering validation thousands of plans
+// that count on the same action for the same atom.
+
+#include <cstddef>
+#include <utility>
+#include <vector>
+
+#include "geometry/solid.hpp"
+#include "planner/atoms.hpp"
+#include "planner/rejection.hpp"
+#include "planner/search.hpp"
+
+namespace hybridctl::planner {
+
+struct Shortfall {
+  int primitive = -1;  // the action's primitive
+  int atom = -1;       // the atom it did not deposit (additive) or did not clear (subtractive)
+  double volume = 0;   // mm^3: the atom's
+  friend bool operator==(const Shortfall&, const Shortfall&) = default;
+};
+
+// What validation says of one candidate: no reasons, it makes the part; else why not, and
+// the shortfalls its execution showed (possibly none).
+struct CandidateCheck {
+  CandidateCheck(std::vector<RejectionReason> reasons = {}, std::vector<Shortfall> shortfalls = {})
+      : reasons(std::move(reasons)), shortfalls(std::move(shortfalls)) {}
+  std::vector<RejectionReason> reasons;
+  std::vector<Shortfall> shortfalls;
+};
+
+// An atom the plan needs falls short when, after the plan's first `steps` actions, less
+// than half of it is as planned: a must-in atom the plan holds by then of which less than
+// half was built, or a must-out atom the plan has cleared of which more than half is still
+// there, when the last of those steps is the one that changed it last in the plan (an
+// earlier action's atom may have been changed since by a later one's spill). Raw stock is
+// never charged (it is there or the plan does not start). `built`: the material after
+// those actions, on the atoms' lattice.
+//
+// What is learned holds once the plan has begun (PrimitiveSpec::falls_short): the plan's
+// first action works on the plate, where what failed later (material over the layer,
+// nothing under it) is not in its way.
+std::vector<Shortfall> find_shortfalls(const PlanningProblem& problem, const AtomDecomposition& atoms, const Plan& plan,
+                                       std::size_t steps, const geometry::Solid& built);
+
+}  // namespace hybridctl::planner

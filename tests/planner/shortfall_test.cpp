@@ -1,0 +1,153 @@
+// What executing a candidate shows about the symbolic model (planner/shortfall.hpp): an
+// atom the plan needs that is not as planned after the action that last changed it is
+// charged to that action's primitive; planning takes it out of the primitive and searches
+// again, so that it offers validation plans that do not count on it.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "config/machine_loader.hpp"
+#include "geometry/mesh.hpp"
+#include "planner/planning.hpp"
+#include "planner/search_steps.hpp"
+#include "planner/shortfall.hpp"
+
+namespace hybridctl::planner {
+namespace {
+
+using geometry::Index3;
+using geometry::Solid;
+
+const geometry::Lattice kMm{1.0, {0, 0, 0}};
+const geometry::IndexBox kRow{{0, 0, 0}, {4, 1, 1}};  // four voxels along X
+
+Solid voxels(int x0, int x1) { return Solid::filled(kMm, {{x0, 0, 0}, {x1, 1, 1}}); }
+
+// A row of four voxels: a deposit of all four (P0), a removal of the last (P1), and a
+// stock of the first (P2). The design is the first three voxels.
+struct Row {
+  AtomDecomposition atoms = AtomDecomposition::recompute(kMm, kRow, {});
+  PlanningProblem problem;
+  Row() {
+    const Solid deposit = voxels(0, 4), removal = voxels(3, 4), stock = voxels(0, 1);
+    atoms = AtomDecomposition::recompute(kMm, kRow, {&deposit, &removal, &stock});
+    for (int a = 0; a < atoms.atom_count(); ++a) {
+      const bool last = atoms.code(a).test(1);
+      problem.atoms.push_back({1.0, !last, last});
+    }
+    const Mode modes[] = {Mode::Additive, Mode::Subtractive, Mode::Additive};
+    for (int i = 0; i < 3; ++i) {
+      PrimitiveSpec p;
+      p.name = "P" + std::to_string(i);
+      p.mode = modes[i];
+      p.raw_stock = i == 2;
+      p.atoms = AtomSet(atoms.atom_count());
+      for (int a = 0; a < atoms.atom_count(); ++a)
+        if (atoms.code(a).test(i)) p.atoms.set(a);
+      problem.primitives.push_back(std::move(p));
+    }
+  }
+  int atom_at(int x) const { return atoms.atom_at({x, 0, 0}); }
+  Plan plan(std::vector<int> primitives) const {
+    Plan plan;
+    for (int i : primitives) plan.steps.push_back({i, 0, 0});
+    return plan;
+  }
+};
+
+TEST(Shortfall, ADepositThatLeftLessThanHalfOfAnAtomTheDesignNeedsFellShortOnIt) {
+  const Row row;
+  // On the stock, deposited all four: the middle two were not built.
+  const std::vector<Shortfall> found = find_shortfalls(row.problem, row.atoms, row.plan({2, 0}), 2, voxels(0, 1));
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].primitive, 0);
+  EXPECT_EQ(found[0].atom, row.atom_at(1));
+  EXPECT_EQ(row.atom_at(1), row.atom_at(2));
+  EXPECT_DOUBLE_EQ(found[0].volume, 2.0);
+  // Built as planned, or only half an atom short: nothing to learn.
+  EXPECT_TRUE(find_shortfalls(row.problem, row.atoms, row.plan({2, 0}), 2, voxels(0, 4)).empty());
+  EXPECT_TRUE(find_shortfalls(row.problem, row.atoms, row.plan({2, 0}), 2, voxels(0, 2)).empty());
+}
+
+TEST(Shortfall, OnlyTheLastActionExecutedIsChargedAndNeverTheFirst) {
+  const Row row;
+  // The removal left the last voxel: it fell short on it.
+  std::vector<Shortfall> found = find_shortfalls(row.problem, row.atoms, row.plan({0, 1}), 2, voxels(0, 4));
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].primitive, 1);
+  EXPECT_EQ(found[0].atom, row.atom_at(3));
+  // Judged after the first action only, the last voxel was meant to be there; and the
+  // first action is not charged with the middle voxels (it works on the plate).
+  EXPECT_TRUE(find_shortfalls(row.problem, row.atoms, row.plan({0, 1}), 1, voxels(0, 1)).empty());
+  // The middle voxels missing after the removal: the deposit before it changed them last,
+  // and what happened to them since is not known.
+  found = find_shortfalls(row.problem, row.atoms, row.plan({2, 0, 1}), 3, voxels(0, 1));
+  EXPECT_TRUE(found.empty());
+}
+
+TEST(Shortfall, RawStockIsNeverCharged) {
+  const Row row;
+  // The stock's voxel missing after the stock alone: the plan did not start, no primitive fell short.
+  EXPECT_TRUE(find_shortfalls(row.problem, row.atoms, row.plan({2}), 1, Solid(kMm, kRow)).empty());
+}
+
+// Planning with a validation that turns the first candidate down, reporting that its last
+// action did not do what the plan counts on for one atom: the search stops, the atom is
+// taken out of that primitive, and the next search offers only plans that do not count on
+// it; the first candidate is not offered again.
+TEST(Shortfall, PlanningLearnsFromARejectionAndSearchesAgainWithoutIt) {
+  const config::Machine machine = config::load_machine(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
+  const geometry::TriangleMesh part = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/flanged-hub.stl");
+  PlanningOptions options;
+  options.voxel_size = 1.0;
+  options.top_k = 2;
+  std::vector<std::vector<int>> offered;
+  Shortfall taught;
+  options.validate = [&](const PlanningResult& r, const Plan& plan) {
+    std::vector<int> sequence;
+    for (const PlanStep& s : plan.steps) sequence.push_back(s.primitive);
+    offered.push_back(sequence);
+    if (offered.size() > 1) return CandidateCheck{};
+    // The last action changed some atom the design needs decided: say it did not.
+    const int last = plan.steps.back().primitive;
+    const PrimitiveSpec& prim = r.problem.primitives[std::size_t(last)];
+    const AtomSet region = step_region(r, plan, plan.steps.size() - 1);
+    for (int a = 0; a < int(r.problem.atoms.size()); ++a) {
+      const AtomSpec& spec = r.problem.atoms[std::size_t(a)];
+      const bool needed = prim.mode == Mode::Additive ? spec.must_in : spec.must_out;
+      if (region.test(a) && needed && (taught.atom < 0 || spec.volume > r.problem.atoms[std::size_t(taught.atom)].volume))
+        taught = {last, a, spec.volume};
+    }
+    return CandidateCheck{{{"missing_material", 0, 0, "the atom is not there", std::nullopt}}, {taught}};
+  };
+  const PlanningResult result = plan_part(part, "flanged-hub.stl", machine, options);
+  ASSERT_GE(taught.atom, 0);
+  ASSERT_EQ(result.rejected.size(), 1u);
+  ASSERT_EQ(result.learned.size(), 1u);
+  EXPECT_EQ(result.learned[0], taught);
+  EXPECT_EQ(result.search_rounds, 2);
+  // Taken out of what the primitive does once the plan has begun; as a first action it still does it.
+  const PrimitiveSpec& charged = result.problem.primitives[std::size_t(taught.primitive)];
+  ASSERT_FALSE(charged.falls_short.words().empty());
+  EXPECT_TRUE(charged.falls_short.test(taught.atom));
+  EXPECT_TRUE(charged.atoms.test(taught.atom));
+  ASSERT_EQ(result.plans.size(), 2u);
+  // Each candidate offered once; every plan kept reaches the design without the primitive
+  // doing what it did not do.
+  for (std::size_t i = 0; i < offered.size(); ++i)
+    EXPECT_EQ(std::count(offered.begin(), offered.end(), offered[i]), 1) << i;
+  for (const Plan& plan : result.plans) {
+    EXPECT_TRUE(is_goal(result.problem, plan.final_state)) << expression(result.problem, plan);
+    AtomSet state(int(result.problem.atoms.size()));
+    Plan replayed;
+    std::vector<int> sequence;
+    for (const PlanStep& s : plan.steps) sequence.push_back(s.primitive);
+    ASSERT_TRUE(detail::simulate(result.problem, sequence, replayed));
+    EXPECT_EQ(replayed.final_state, plan.final_state);
+  }
+  EXPECT_NE(learned_text(result).find("falling short of the model on 1 atom"), std::string::npos) << learned_text(result);
+}
+
+}  // namespace
+}  // namespace hybridctl::planner
