@@ -1,6 +1,8 @@
 #include "planner/check.hpp"
 
 #include <algorithm>
+#include <bit>
+#include <utility>
 #include <cstdio>
 
 namespace hybridctl::planner {
@@ -85,6 +87,54 @@ bool subtractive_only_possible(const PlanningProblem& p) {
   return false;
 }
 
+// A must-in atom is made by the last deposit that holds it, after which no removal that
+// holds it may come; every must-out atom that deposit holds is then present, and only a
+// removal that spares the atom can clear it. So some deposit holding the atom must hold
+// only must-out atoms that some removal sparing it holds. (A deposit lays all its atoms: the
+// search refuses one the state keeps out of reach or without footing, it does not cut it.)
+// For each atom that has none, a sentence naming the deposits and what each leaves.
+std::vector<std::pair<int, std::string>> atoms_no_deposit_makes(const PlanningProblem& p,
+                                                                const std::vector<AtomMeasures>& measures) {
+  const int m = int(p.atoms.size());
+  AtomSet must_out(m);
+  for (int a = 0; a < m; ++a)
+    if (p.atoms[std::size_t(a)].must_out) must_out.set(a);
+  std::vector<std::pair<int, std::string>> out;
+  for (int a = 0; a < m; ++a) {
+    if (!p.atoms[std::size_t(a)].must_in) continue;
+    AtomSet sparing(m);
+    for (const PrimitiveSpec& prim : p.primitives)
+      if (prim.mode == Mode::Subtractive && !prim.atoms.test(a))
+        for (std::size_t w = 0; w < sparing.words().size(); ++w) sparing.words()[w] |= prim.atoms.words()[w];
+    std::string left;
+    int deposits = 0;
+    bool made = false;
+    for (const PrimitiveSpec& prim : p.primitives) {
+      if (prim.mode != Mode::Additive || !prim.atoms.test(a)) continue;
+      ++deposits;
+      int stuck = -1;
+      for (std::size_t w = 0; w < sparing.words().size() && stuck < 0; ++w)
+        if (const std::uint64_t bad = prim.atoms.words()[w] & must_out.words()[w] & ~sparing.words()[w])
+          stuck = int(w * 64) + std::countr_zero(bad);
+      if (stuck < 0) {
+        made = true;
+        break;
+      }
+      if (deposits <= 3) {
+        const AtomMeasures& b = measures[std::size_t(stuck)];
+        left += (left.empty() ? "" : "; ") + prim.name + " leaves " + format("%.3g", b.volume) + " mm\u00B3 around " +
+                format("(%.1f, %.1f, %.1f)", b.centroid.x, b.centroid.y, b.centroid.z) + " mm";
+      }
+    }
+    if (made) continue;
+    out.emplace_back(a, deposits == 0 ? std::string("no deposit holds it")
+                                      : "every deposit that holds it (" + std::to_string(deposits) +
+                                            ") also lays material outside the design that only removals cutting into it "
+                                            "clear (" + left + (deposits > 3 ? "; ..." : "") + ")");
+  }
+  return out;
+}
+
 }  // namespace
 
 Verdict check_manufacturability(const PlanningProblem& p, const std::vector<AtomMeasures>& measures,
@@ -145,6 +195,34 @@ Verdict check_manufacturability(const PlanningProblem& p, const std::vector<Atom
                                    : "not manufacturable: no stock and removals leave the design";
       return v;
     case Modality::Hybrid:
+      for (const auto& [a, why] : atoms_no_deposit_makes(p, measures)) {
+        const AtomMeasures& m = measures[std::size_t(a)];
+        ViolatingAtom va;
+        va.atom = a;
+        va.code = m.code.bits(int(p.primitives.size()));
+        for (int i = 0; i < int(p.primitives.size()); ++i)
+          if (m.code.test(i)) va.primitives.push_back(i);
+        va.volume = m.volume;
+        va.volume_in_design = m.volume_in_design;
+        va.bounds = lattice.extent(m.bounding_box);
+        va.centroid = m.centroid;
+        va.holds_core = m.voxels_in_core > 0;
+        va.holds_thin_feature = m.thin_feature;
+        va.description = "a " + format("%.3g", m.volume) + " mm\u00B3 region of the design around " +
+                         format("(%.1f, %.1f, %.1f)", m.centroid.x, m.centroid.y, m.centroid.z) + " mm: " + why;
+        v.violations.push_back(std::move(va));
+      }
+      if (!v.violations.empty()) {
+        std::sort(v.violations.begin(), v.violations.end(),
+                  [](const ViolatingAtom& x, const ViolatingAtom& y) { return x.volume > y.volume; });
+        v.manufacturable = false;
+        v.decided_without_search = true;
+        v.summary = "not manufacturable: " + std::to_string(v.violations.size()) +
+                    (v.violations.size() == 1 ? " atom" : " atoms") +
+                    " of the design no deposit makes without material outside it that only removals cutting into "
+                    "the atom clear";
+        return v;
+      }
       v.manufacturable = true;  // necessary condition holds; the search decides
       v.summary = "no atom straddles the design; hybrid plans are searched";
       return v;

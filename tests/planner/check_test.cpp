@@ -103,3 +103,43 @@ TEST(Check, AThinFeatureOnlyAnOverfillReachesIsAViolationThatSaysSo) {
 
 }  // namespace
 }  // namespace hybridctl::planner
+
+namespace hybridctl::planner {
+namespace {
+
+// A design atom is made by the last deposit that holds it, and no removal that holds it
+// may follow: what that deposit lays outside the design must be cleared by removals that
+// spare the atom. Here the one deposit overfills past x = 12, and the one removal that
+// reaches the overfill also cuts the design's last 2 mm: that strip is never made. (A
+// second deposit of the overfill alone splits the atoms at the design's face.)
+TEST(Check, ADesignAtomThatEveryDepositLeavesOnlyForRemovalsCuttingIntoItIsRefusedWithoutSearch) {
+  const Solid design = box(2, 12);
+  const Verdict no = verdict_of({{"deposit", Mode::Additive, false, 1, box(2, 14)},
+                                 {"spill", Mode::Additive, false, 1, box(12, 14)},
+                                 {"trim", Mode::Subtractive, false, 1, box(0, 2)},
+                                 {"cut", Mode::Subtractive, false, 1, box(10, 20)}},
+                                design);
+  EXPECT_FALSE(no.manufacturable);
+  EXPECT_TRUE(no.decided_without_search);
+  ASSERT_EQ(no.violations.size(), 1u);
+  EXPECT_NEAR(no.violations[0].centroid.x, 11.0, 1e-9);
+  EXPECT_DOUBLE_EQ(no.violations[0].volume, 80.0);
+  EXPECT_NE(no.violations[0].description.find("every deposit that holds it (1) also lays material outside the design"),
+            std::string::npos)
+      << no.violations[0].description;
+  EXPECT_NE(no.violations[0].description.find("deposit leaves 80 mm\u00B3 around (13.0, 5.0, 2.0) mm"), std::string::npos)
+      << no.violations[0].description;
+  // A removal that clears the overfill and spares the strip: the search decides.
+  const Verdict yes = verdict_of({{"deposit", Mode::Additive, false, 1, box(2, 14)},
+                                  {"spill", Mode::Additive, false, 1, box(12, 14)},
+                                  {"trim", Mode::Subtractive, false, 1, box(0, 2)},
+                                  {"cut", Mode::Subtractive, false, 1, box(10, 20)},
+                                  {"finish", Mode::Subtractive, false, 1, box(12, 20)}},
+                                 design);
+  EXPECT_TRUE(yes.manufacturable);
+  EXPECT_FALSE(yes.decided_without_search);
+  EXPECT_TRUE(yes.violations.empty());
+}
+
+}  // namespace
+}  // namespace hybridctl::planner
