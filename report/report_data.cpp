@@ -85,7 +85,7 @@ class Gatherer {
     doc["format"] = "hybridctl-report";
     doc["version"] = 1;
     for (const char* key : {"part", "tolerance", "sliver_threshold", "cost_normaliser", "fixed_costs", "search",
-                            "timings_s", "grid"})
+                            "learned", "timings_s", "grid"})
       doc[key] = field(raw_, key);
     doc["machine"] = {{"name", file_.machine_name}, {"file", file_.machine_file}};
     doc["voxel_size"] = file_.lattice.voxel_size;

@@ -168,7 +168,12 @@
     const part = String(data.part || 'part').split('/').pop();
     h.append(el('h1', '', part));
     const v = data.verdict || {};
-    h.append(el('span', 'badge ' + (v.manufacturable ? 'ok' : 'bad'), v.manufacturable ? 'manufacturable' : 'NOT manufacturable'));
+    // As `plan` says it: undecided when the search stopped at its limits or learned from
+    // rejected candidates, and nothing decided the part before the search.
+    const undecided = !v.manufacturable && !v.decided_without_search &&
+                      ((data.search && data.search.limit_reached) || (data.learned || []).length > 0);
+    h.append(el('span', 'badge ' + (v.manufacturable ? 'ok' : 'bad'),
+                v.manufacturable ? 'manufacturable' : undecided ? 'UNDECIDED' : 'NOT manufacturable'));
     const facts = [(data.machine && data.machine.name) || '', 'voxel ' + fmt(data.voxel_size, 2) + ' mm',
                    'tolerance ' + fmt(data.tolerance, 2) + ' mm', (data.atoms ? data.atoms.count : 0) + ' atoms',
                    (data.primitives || []).length + ' primitives', (data.plans || []).length + ' plans'];
