@@ -135,6 +135,25 @@ std::vector<std::pair<int, std::string>> atoms_no_deposit_makes(const PlanningPr
   return out;
 }
 
+// An atom that rules the part out, located, with the primitives holding it and what the
+// tolerance zone says of it; the caller writes its description.
+ViolatingAtom offending_atom(const PlanningProblem& p, const AtomMeasures& m, int a, const Lattice& lattice) {
+  ViolatingAtom va;
+  va.atom = a;
+  va.code = m.code.bits(int(p.primitives.size()));
+  for (int i = 0; i < int(p.primitives.size()); ++i)
+    if (m.code.test(i)) va.primitives.push_back(i);
+  va.volume = m.volume;
+  va.volume_in_design = m.volume_in_design;
+  va.bounds = lattice.extent(m.bounding_box);
+  va.centroid = m.centroid;
+  va.holds_core = m.voxels_in_core > 0;
+  va.holds_thin_feature = m.thin_feature;
+  va.beyond_hull = m.voxels_beyond_hull > 0;
+  va.holds_thin_gap = m.thin_gap;
+  return va;
+}
+
 }  // namespace
 
 Verdict check_manufacturability(const PlanningProblem& p, const std::vector<AtomMeasures>& measures,
@@ -156,19 +175,7 @@ Verdict check_manufacturability(const PlanningProblem& p, const std::vector<Atom
   for (int a = 0; a < int(measures.size()); ++a) {
     const AtomMeasures& m = measures[std::size_t(a)];
     if (m.atom_class != AtomClass::Violating) continue;
-    ViolatingAtom va;
-    va.atom = a;
-    va.code = m.code.bits(int(p.primitives.size()));
-    for (int i = 0; i < int(p.primitives.size()); ++i)
-      if (m.code.test(i)) va.primitives.push_back(i);
-    va.volume = m.volume;
-    va.volume_in_design = m.volume_in_design;
-    va.bounds = lattice.extent(m.bounding_box);
-    va.centroid = m.centroid;
-    va.holds_core = m.voxels_in_core > 0;
-    va.holds_thin_feature = m.thin_feature;
-    va.beyond_hull = m.voxels_beyond_hull > 0;
-    va.holds_thin_gap = m.thin_gap;
+    ViolatingAtom va = offending_atom(p, m, a, lattice);
     va.description = describe(p, va);
     v.violations.push_back(std::move(va));
   }
@@ -197,17 +204,7 @@ Verdict check_manufacturability(const PlanningProblem& p, const std::vector<Atom
     case Modality::Hybrid:
       for (const auto& [a, why] : atoms_no_deposit_makes(p, measures)) {
         const AtomMeasures& m = measures[std::size_t(a)];
-        ViolatingAtom va;
-        va.atom = a;
-        va.code = m.code.bits(int(p.primitives.size()));
-        for (int i = 0; i < int(p.primitives.size()); ++i)
-          if (m.code.test(i)) va.primitives.push_back(i);
-        va.volume = m.volume;
-        va.volume_in_design = m.volume_in_design;
-        va.bounds = lattice.extent(m.bounding_box);
-        va.centroid = m.centroid;
-        va.holds_core = m.voxels_in_core > 0;
-        va.holds_thin_feature = m.thin_feature;
+        ViolatingAtom va = offending_atom(p, m, a, lattice);
         va.description = "a " + format("%.3g", m.volume) + " mm\u00B3 region of the design around " +
                          format("(%.1f, %.1f, %.1f)", m.centroid.x, m.centroid.y, m.centroid.z) + " mm: " + why;
         v.violations.push_back(std::move(va));
