@@ -253,6 +253,7 @@ json plans_json(const PlanningResult& r) {
                      {"toolpath_minutes", toolpath_total(r, k)},
                      {"optimality", optimality(plan, search_rank(r, k))},
                      {"search_rank", search_rank(r, k) + 1},
+                     {"found_by", plan.exact ? "exact-search" : plan.built ? "built-step-by-step" : "weighted-search"},
                      {"toolpath_cost", k < r.toolpath_costs.size() ? json(r.toolpath_costs[k]) : json(nullptr)},
                      {"gap", std::isfinite(plan.gap) ? json(plan.gap) : json(nullptr)},
                      {"file", "plans/plan-" + std::to_string(k + 1) + ".vdb"},
@@ -458,9 +459,13 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
   if (!r.plans.empty()) {
     os << "plans       " << r.plans.size() << " (A*: " << r.search.expanded << " states expanded in "
        << fixed(r.search.seconds, 2) << " s";
-    if (r.search.weight > 1)
-      os << "; the exact search hit its limit, so plans it did not prove come from weighted A* (w = "
-         << r.search.weight << ") with a proven gap against the lower bound " << fixed(r.search.lower_bound, 4);
+    const bool built = std::any_of(r.plans.begin(), r.plans.end(), [](const Plan& p) { return p.built; });
+    if (r.search.weight > 1 || built) {
+      os << "; the exact search hit its limit, so plans it did not prove come from ";
+      if (r.search.weight > 1) os << "weighted A* (w = " << r.search.weight << ")" << (built ? " and " : "");
+      if (built) os << "plans built step by step (deposit the missing design, then mill what lies outside it)";
+      os << " with a proven gap against the lower bound " << fixed(r.search.lower_bound, 4);
+    }
     os << ")\n";
     if (r.ranked_by_toolpaths)
       os << "ranked      by the toolpaths' cycle times: " << r.estimates_off

@@ -2,6 +2,7 @@
 
 #include "planner/search_backward.hpp"
 #include "planner/search_bound.hpp"
+#include "planner/search_greedy.hpp"
 #include "planner/search_reduce.hpp"
 #include "planner/search_steps.hpp"
 
@@ -204,7 +205,7 @@ template <class Make>
 void fill_with_weighted(const SearchOptions& options, const Make& make, Clock::time_point start, std::vector<Plan>& plans,
                         SearchStats& st) {
   const double weights[] = {50.0, 5.0, 2.0};
-  const std::size_t exact = plans.size();
+  const std::size_t exact = std::size_t(std::count_if(plans.begin(), plans.end(), [](const Plan& p) { return p.exact; }));
   const int slots = options.top_k - int(exact);
   auto by_cost = [](const Plan& a, const Plan& b) { return a.cost < b.cost; };
   for (std::size_t k = 0; k < std::size(weights); ++k) {
@@ -242,12 +243,41 @@ void fill_with_weighted(const SearchOptions& options, const Make& make, Clock::t
   }
 }
 
+// How many plans greedy_sequences offers the filter at most: enough for top k after a few
+// turned down, few enough that building them stays cheap.
+constexpr std::size_t kGreedyCandidates = 24;
+
+// Plans built step by step (planner/search_greedy.hpp), cheapest first, judged as the
+// search's are: those accepted take free slots after the exact plans.
+void fill_with_greedy(const PlanningProblem& p, const SearchOptions& options, std::vector<Plan>& plans,
+                      SearchStats& st) {
+  const int slots = options.top_k - int(plans.size());
+  if (slots <= 0) return;
+  std::set<std::vector<int>> known;
+  for (const Plan& plan : plans) known.insert(sequence_of(plan));
+  GoalFilter goals(p, options, known, st);
+  int taken = 0;
+  for (const std::vector<int>& sequence : greedy_sequences(p, kGreedyCandidates)) {
+    if (taken >= slots || st.rejected >= options.max_rejected) break;
+    Plan plan;
+    if (!simulate(p, sequence, plan)) continue;
+    const GoalFilter::Verdict verdict = goals.judge(plan);
+    if (verdict == GoalFilter::Take) {
+      plan.exact = false;
+      plan.built = true;
+      plans.push_back(std::move(plan));
+      ++taken;
+    }
+    if (verdict == GoalFilter::Stop) break;
+  }
+}
+
 // The exact search, then weighted ones when it stops at a limit, in one direction: `make`
 // gives a search (Search or BackwardSearch) for the options, deadline, known plans, stats
 // and cost to prune at.
 template <class Make>
-std::vector<Plan> exact_then_weighted(const SearchOptions& options, const Make& make, SearchStats& st,
-                                      Clock::time_point start) {
+std::vector<Plan> exact_then_weighted(const PlanningProblem& p, const SearchOptions& options, const Make& make,
+                                      SearchStats& st, Clock::time_point start) {
   const std::set<std::vector<int>> none;
   Clock::time_point deadline = Clock::time_point::max();
   if (options.time_limit > 0)
@@ -262,7 +292,8 @@ std::vector<Plan> exact_then_weighted(const SearchOptions& options, const Make& 
   } else if (int(plans.size()) < options.top_k && !exact.stopped_at_limit()) {
     st.exhausted = true;
   } else if (int(plans.size()) < options.top_k && !st.interrupted) {
-    fill_with_weighted(options, make, start, plans, st);
+    fill_with_greedy(p, options, plans, st);
+    if (!st.interrupted) fill_with_weighted(options, make, start, plans, st);
   }
   // Gaps against the best proven lower bound on the cheapest accepted plan.
   const bool first_exact = !plans.empty() && plans.front().exact;
@@ -296,12 +327,12 @@ std::vector<Plan> search_plans(const PlanningProblem& p, const SearchOptions& op
   if (backwards(p, options)) {
     const auto make = [&](const SearchOptions& o, Clock::time_point deadline, const Known& known, SearchStats& s,
                           double prune_at) { return BackwardSearch(p, o, deadline, known, s, prune_at); };
-    return exact_then_weighted(options, make, st, start);
+    return exact_then_weighted(p, options, make, st, start);
   }
   const LowerBound bound(p);
   const auto make = [&](const SearchOptions& o, Clock::time_point deadline, const Known& known, SearchStats& s,
                         double prune_at) { return Search(p, o, bound, deadline, known, s, prune_at); };
-  return exact_then_weighted(options, make, st, start);
+  return exact_then_weighted(p, options, make, st, start);
 }
 
 }  // namespace

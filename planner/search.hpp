@@ -93,6 +93,7 @@ struct Plan {
   // dearer it is than the first.
   double gap = 0;
   bool exact = true;  // proven to be the rank-th cheapest accepted plan
+  bool built = false;  // built step by step (planner/search_greedy.hpp), not found by a search
 };
 
 struct SearchStats {
