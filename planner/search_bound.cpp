@@ -130,23 +130,95 @@ LowerBound::Rates LowerBound::rates(const std::vector<std::uint8_t>& uses, bool 
   return Rates{*this, usable(uses, first)};
 }
 
-double LowerBound::atom_part(const AtomSet& state, const Rates& r) const {
+LowerBound::AtomShares LowerBound::atom_part(const AtomSet& state, const Rates& r) const {
   const auto& s = state.words();
-  double h = 0;
+  AtomShares h;
   for (std::size_t w = 0; w < s.size(); ++w) {
     for (std::uint64_t b = must_in_[w] & ~s[w]; b; b &= b - 1) {
       const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
-      h += r.deposit(a) * p_.atoms[a].volume;
+      h.deposits += r.deposit(a) * p_.atoms[a].volume;
     }
     for (std::uint64_t b = must_out_[w] & s[w]; b; b &= b - 1) {
       const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
-      h += r.remove(a) * p_.atoms[a].volume;
+      h.removals += r.remove(a) * p_.atoms[a].volume;
     }
   }
   return h;  // infinite when some needed atom has no supplier left
 }
 
-double LowerBound::side_effects(const AtomSet& state, const Rates& r) const {
+// A completion removes every must-out atom present, and a removal that cuts design present
+// (or design a removal before it cut) is followed by a deposit of that design. Let r* be
+// the used removal whose design share R (the design present in it, at the cheapest rates
+// that deposit it) is largest: the completion pays at least R(r*) for deposits, and removes
+// each must-out atom present with one of the removals whose R is at most R(r*). So the
+// least over thresholds t of t + (each must-out atom present at the cheapest rate of a
+// removal with R <= t) bounds this share; t = 0 are the removals that spare the design.
+// It never falls by more than a removal costs plus the design it cuts (which the atom
+// part's deposits then charge): the threshold that covers the removal taken does as well
+// before it.
+double LowerBound::removals_with_design_cut(const AtomSet& state, const Rates& r) const {
+  const auto& s = state.words();
+  // Each allowed removal's design share in this state.
+  std::vector<std::pair<double, int>> shares;
+  for (std::size_t i = 0; i < p_.primitives.size(); ++i) {
+    const PrimitiveSpec& prim = p_.primitives[i];
+    if (prim.mode != Mode::Subtractive || !r.allowed[i]) continue;
+    const auto& pa = prim.atoms.words();
+    const auto& short_of = prim.falls_short.words();
+    double share = 0;
+    for (std::size_t w = 0; w < s.size(); ++w) {
+      const std::uint64_t cut = pa[w] & s[w] & must_in_[w] & ~(w < short_of.size() ? short_of[w] : 0);
+      for (std::uint64_t b = cut; b; b &= b - 1) {
+        const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
+        share += r.deposit(a) * p_.atoms[a].volume;
+      }
+    }
+    shares.emplace_back(share, int(i));
+  }
+  std::sort(shares.begin(), shares.end());
+  // Thresholds: 0 and each distinct share; per removal the first threshold admitting it.
+  std::vector<double> threshold{0.0};
+  std::vector<int> rank(p_.primitives.size(), -1);
+  for (const auto& [share, i] : shares) {
+    if (share > threshold.back()) threshold.push_back(share);
+    rank[std::size_t(i)] = int(threshold.size()) - 1;
+  }
+  const std::size_t k = threshold.size();
+  // The must-out volume present per remover list: atoms of one list price alike.
+  std::vector<double> volume(lists_.size(), 0);
+  for (std::size_t w = 0; w < s.size(); ++w)
+    for (std::uint64_t b = must_out_[w] & s[w]; b; b &= b - 1) {
+      const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
+      volume[std::size_t(remover_list_[a])] += p_.atoms[a].volume;
+    }
+  // total[j]: the must-out atoms at threshold j, as differences from j to j + 1.
+  std::vector<double> step(k + 1, 0);
+  std::size_t priced_from = 0;  // the least threshold at which every such atom has a removal
+  for (std::size_t l = 0; l < lists_.size(); ++l) {
+    if (volume[l] == 0) continue;
+    // Cheapest first: a remover admitted at a lower threshold than all cheaper ones sets
+    // the price from its threshold up to theirs.
+    int lowest = int(k);  // the least threshold at which a cheaper remover is admitted
+    for (int i : lists_[l]) {
+      const int j = rank[std::size_t(i)];
+      if (j < 0 || j >= lowest) continue;
+      const double price = p_.primitives[std::size_t(i)].cost_per_mm3 * volume[l];
+      step[std::size_t(j)] += price;
+      step[std::size_t(lowest)] -= price;
+      lowest = j;
+    }
+    if (lowest == int(k)) return kInfinity;  // no removal left for these atoms
+    priced_from = std::max(priced_from, std::size_t(lowest));  // below it they cannot go
+  }
+  double best = kInfinity, total = 0;
+  for (std::size_t j = 0; j < k; ++j) {
+    total += step[j];
+    if (j >= priced_from) best = std::min(best, threshold[j] + total);
+  }
+  return best;
+}
+
+LowerBound::SideShares LowerBound::side_effects(const AtomSet& state, const Rates& r) const {
   const auto& s = state.words();
   // What using primitive i costs beyond the atoms the atom part charges: absent atoms
   // that are not must-in (deposited, and removed again when must-out) for an additive
@@ -194,7 +266,7 @@ double LowerBound::side_effects(const AtomSet& state, const Rates& r) const {
     const bool adds = p_.primitives[std::size_t(lists_[l].front())].mode == Mode::Additive;
     (adds ? add : remove) = std::max(adds ? add : remove, least(lists_[l]));
   }
-  return add + remove;
+  return {add, remove};
 }
 
 // The tools and setups some needed atom of `state` can only be changed with.
@@ -274,18 +346,21 @@ double LowerBound::quick(const AtomSet& state, const std::vector<std::uint8_t>& 
 
 double LowerBound::quick(const AtomSet& state, const std::vector<bool>& within, int last) const {
   const Rates r{*this, within};
-  const double atoms = atom_part(state, r);
-  if (atoms == kInfinity) return kInfinity;
-  return (atoms + fixed_part(state, r, last)) / p_.normaliser;
+  const AtomShares atoms = atom_part(state, r);
+  if (atoms.deposits + atoms.removals == kInfinity) return kInfinity;
+  return (atoms.deposits + atoms.removals + fixed_part(state, r, last)) / p_.normaliser;
 }
 
 double LowerBound::operator()(const AtomSet& state, const std::vector<std::uint8_t>& uses, int last) const {
   const Rates r = rates(uses, last < 0);
-  const double atoms = atom_part(state, r);
-  if (atoms == kInfinity) return kInfinity;
-  const double side = side_effects(state, r);
-  if (side == kInfinity) return kInfinity;
-  return (atoms + side + fixed_part(state, r, last)) / p_.normaliser;
+  const AtomShares atoms = atom_part(state, r);
+  if (atoms.deposits + atoms.removals == kInfinity) return kInfinity;
+  const SideShares side = side_effects(state, r);
+  if (side.deposits + side.removals == kInfinity) return kInfinity;
+  // Removing what is present (and depositing again the design a removal cuts) is one share,
+  // bounded two ways: the larger counts.
+  const double removals = std::max(atoms.removals + side.removals, removals_with_design_cut(state, r));
+  return (atoms.deposits + side.deposits + removals + fixed_part(state, r, last)) / p_.normaliser;
 }
 
 }  // namespace hybridctl::planner

@@ -9,6 +9,10 @@
 //    deposits its absent other atoms (and any must-out one among them must then be
 //    removed); likewise the removal of a must-out atom takes present other atoms with it
 //    (a must-in one must come back);
+//  - removals with the design they cut: a removal that cuts design present is followed by a
+//    deposit of it, so each must-out atom present is priced among the removals whose
+//    design share is at most a threshold, plus the threshold, least over thresholds (this
+//    and the removal parts of the two above bound one share: the larger counts);
 //  - fixed costs: a mode switch when the other mode is still needed (two when every
 //    additive primitive left holds a must-out atom and the plan is removing now), a tool
 //    change per tool that some atom can only be changed by, other than the current one,
@@ -53,8 +57,14 @@ class LowerBound {
   struct Rates;
   friend struct Rates;
   Rates rates(const std::vector<std::uint8_t>& uses, bool first) const;
-  double atom_part(const AtomSet& state, const Rates& r) const;
-  double side_effects(const AtomSet& state, const Rates& r) const;
+  // Shares of the bound: what depositing and what removing still costs.
+  struct AtomShares {
+    double deposits = 0, removals = 0;
+  };
+  using SideShares = AtomShares;
+  AtomShares atom_part(const AtomSet& state, const Rates& r) const;
+  SideShares side_effects(const AtomSet& state, const Rates& r) const;
+  double removals_with_design_cut(const AtomSet& state, const Rates& r) const;
   double fixed_part(const AtomSet& state, const Rates& r, int last) const;
   void index_lists();
   void force(const AtomSet& state, const Rates& r, std::vector<bool>& tool_forced, std::vector<bool>& setup_forced) const;
