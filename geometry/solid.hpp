@@ -88,7 +88,11 @@ class Solid {
 
   std::int64_t voxel_count() const;
   double volume() const;  // mm^3
-  bool empty() const { return voxel_count() == 0; }
+  bool empty() const {
+    for (std::uint64_t w : words_)
+      if (w) return false;
+    return true;
+  }
   // Tight box of the occupied voxels; empty box when the solid is empty.
   IndexBox bounding_box() const;
   Box3 bounding_box_mm() const { return lattice_.extent(bounding_box()); }

@@ -241,12 +241,13 @@ PocketBuilder::Levels PocketBuilder::cutting_levels() const {
   for (int k = rb.hi.z - down_; k > rb.lo.z; k -= down_) levels.insert(k);
   levels.insert(rb.lo.z);
   std::vector<std::uint64_t> held;  // per word of a row: something that stays within a step-down below
+  const bool anything_held = !untouchable_.empty();  // a whole-grid count: once, not per row
   for (int z = rb.lo.z + 1; z < rb.hi.z; ++z) {
     bool floor_here = false;
     for (int y = rb.lo.y; y < rb.hi.y && !floor_here; ++y) {
       const auto now = remaining_.row(y, z), below = remaining_.row(y, z - 1);
       held.assign(now.size(), 0);
-      for (int d = 1; d <= down_ && !untouchable_.empty(); ++d) held_rows(y, z - d, held);
+      for (int d = 1; d <= down_ && anything_held; ++d) held_rows(y, z - d, held);
       for (std::size_t w = 0; w < now.size(); ++w)
         if (now[w] & ~below[w] & held[w]) {
           floor_here = true;
