@@ -146,6 +146,24 @@ namespace {
 
 const std::string kMachine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/hybrid-3axis.yaml";
 
+// The B-axis machine's 66 primitives (issue 15): the bound that prices removals with the
+// design they cut proves the block milled to the bracket optimal, and the plan is executed
+// from the block before it is offered.
+TEST_F(Cli, TheBracketOnTheBAxisMachineIsMilledFromTheBlockProvenOptimalAndExecuted) {
+  const std::string machine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/multitask-b-axis.yaml";
+  const Outcome r = run({"plan", kBracket, "--machine", machine, "--top", "1", "-o", (dir_ / "plan").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("proven optimal"), std::string::npos) << r.out;
+  // The first action is the block (P2), not a deposit finished by milling.
+  const std::size_t first = r.out.find("  1. (");
+  ASSERT_NE(first, std::string::npos) << r.out;
+  EXPECT_EQ(r.out.compare(r.out.find('P', first), 3, "P2 "), 0) << r.out;
+  EXPECT_NE(r.out.find("every plan offered was exported and executed from the raw stock"), std::string::npos) << r.out;
+  const std::string json = slurp(dir_ / "plan" / "plan.json");
+  EXPECT_NE(json.find("\"found_by\": \"exact-search\""), std::string::npos);
+  EXPECT_NE(json.find("\"within_tolerance\": true"), std::string::npos);
+}
+
 TEST_F(Cli, PlansTheFlangedHubAndWritesPlanJsonWithValidPlans) {
   const Outcome r = run({"plan", "--no-validate", kFlangedHub, "--machine", kMachine, "--voxel", "1", "-o", (dir_ / "plan").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
