@@ -152,8 +152,8 @@ void add_plan_command(CLI::App& app, Runner& runner) {
       ->check(between(1, 8));
   cmd->add_option("--search-time", args->search_time,
                   "Seconds the plan search may take (default: no budget, only its expansion and state limits). "
-                  "Plans the exact search has not proven by half of it come from weighted A*, each with its proven "
-                  "gap; a budget makes the result depend on the machine's speed")
+                  "Plans the exact search has not proven by half of it are built step by step or come from weighted A*, "
+                  "each with its proven gap; a budget makes the result depend on the machine's speed")
       ->check(greater_than(0));
   cmd->add_option("--primitive", args->primitive_files,
                   "Extra primitive FILE:am or FILE:sm (STL, or .vdb on the plan's voxel grid); repeatable");
