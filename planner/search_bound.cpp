@@ -158,6 +158,10 @@ LowerBound::AtomShares LowerBound::atom_part(const AtomSet& state, const Rates& 
 // before it.
 double LowerBound::removals_with_design_cut(const AtomSet& state, const Rates& r) const {
   const auto& s = state.words();
+  // Nothing to remove, or (below) no removal cutting design: the atom part prices it as well.
+  bool waste = false;
+  for (std::size_t w = 0; w < s.size() && !waste; ++w) waste = (must_out_[w] & s[w]) != 0;
+  if (!waste) return 0;
   // Each allowed removal's design share in this state.
   std::vector<std::pair<double, int>> shares;
   for (std::size_t i = 0; i < p_.primitives.size(); ++i) {
@@ -176,6 +180,7 @@ double LowerBound::removals_with_design_cut(const AtomSet& state, const Rates& r
     shares.emplace_back(share, int(i));
   }
   std::sort(shares.begin(), shares.end());
+  if (shares.empty() || shares.back().first == 0) return 0;
   // Thresholds: 0 and each distinct share; per removal the first threshold admitting it.
   std::vector<double> threshold{0.0};
   std::vector<int> rank(p_.primitives.size(), -1);
