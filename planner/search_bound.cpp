@@ -158,10 +158,6 @@ LowerBound::AtomShares LowerBound::atom_part(const AtomSet& state, const Rates& 
 // before it.
 double LowerBound::removals_with_design_cut(const AtomSet& state, const Rates& r) const {
   const auto& s = state.words();
-  // Nothing to remove, or (below) no removal cutting design: the atom part prices it as well.
-  bool waste = false;
-  for (std::size_t w = 0; w < s.size() && !waste; ++w) waste = (must_out_[w] & s[w]) != 0;
-  if (!waste) return 0;
   // Each allowed removal's design share in this state.
   std::vector<std::pair<double, int>> shares;
   for (std::size_t i = 0; i < p_.primitives.size(); ++i) {
@@ -180,7 +176,7 @@ double LowerBound::removals_with_design_cut(const AtomSet& state, const Rates& r
     shares.emplace_back(share, int(i));
   }
   std::sort(shares.begin(), shares.end());
-  if (shares.empty() || shares.back().first == 0) return 0;
+  if (shares.empty() || shares.back().first == 0) return 0;  // no removal cuts design: the atom part prices it
   // Thresholds: 0 and each distinct share; per removal the first threshold admitting it.
   std::vector<double> threshold{0.0};
   std::vector<int> rank(p_.primitives.size(), -1);
@@ -364,7 +360,9 @@ double LowerBound::operator()(const AtomSet& state, const std::vector<std::uint8
   if (side.deposits + side.removals == kInfinity) return kInfinity;
   // Removing what is present (and depositing again the design a removal cuts) is one share,
   // bounded two ways: the larger counts.
-  const double removals = std::max(atoms.removals + side.removals, removals_with_design_cut(state, r));
+  // With no waste present (the atom part's removals are 0) there is nothing to price.
+  const double removals =
+      std::max(atoms.removals + side.removals, atoms.removals > 0 ? removals_with_design_cut(state, r) : 0.0);
   return (atoms.deposits + side.deposits + removals + fixed_part(state, r, last)) / p_.normaliser;
 }
 
