@@ -66,10 +66,26 @@ struct RowMask {
   }
 };
 
+// Whether row (y, z) of `stock` holds material in some word that voxels [x0, x1) touch.
+bool row_has_material(const geometry::Solid& stock, const IndexBox& d, int y, int z, int x0, int x1) {
+  if (y < d.lo.y || y >= d.hi.y || z < d.lo.z || z >= d.hi.z) return false;
+  const int w0 = std::max(word_of(x0), stock.first_word());
+  const int w1 = std::min(word_of(x1 - 1) + 1, stock.first_word() + stock.words_per_row());
+  if (w0 >= w1) return false;
+  const std::uint64_t* s = stock.row(y, z).data() - stock.first_word();
+  std::uint64_t any = 0;
+  for (int w = w0; w < w1; ++w) any |= s[w];
+  return any != 0;
+}
+
 // Rasterises the sweep of `pieces` along every segment into `mask` (the union), over the
 // swept bounds intersected with `clip` (empty: unclipped, finite pieces only).
+// `only_over`, when given: the mask is only ever intersected with this stock as it is now
+// or with less of it (a cut, a collision test), so rows where it holds no material near
+// the sweep are left empty instead of computed. Most of a holder's and a nozzle's body
+// sweeps air: this is what keeps their tests cheap.
 void rasterise(RowMask& mask, std::span<const ConvexPiece> pieces, std::span<const Segment> segments,
-               const geometry::Lattice& lattice, const IndexBox& clip) {
+               const geometry::Lattice& lattice, const IndexBox& clip, const geometry::Solid* only_over = nullptr) {
   struct Job {
     PieceSweep sweep;
     IndexBox box;
@@ -86,9 +102,11 @@ void rasterise(RowMask& mask, std::span<const ConvexPiece> pieces, std::span<con
       jobs.push_back({sweep, box});
     }
   mask.reset(all);
+  const IndexBox stored = only_over ? only_over->storage_box() : IndexBox{};
   for (const Job& job : jobs)
     for (int z = job.box.lo.z; z < job.box.hi.z; ++z)
       for (int y = job.box.lo.y; y < job.box.hi.y; ++y) {
+        if (only_over && !row_has_material(*only_over, stored, y, z, job.box.lo.x, job.box.hi.x)) continue;
         const XRange r = job.sweep.row(y, z);
         if (!r.empty()) mask.add(y, z, r.x0, r.x1);
       }
@@ -273,8 +291,8 @@ MoveReport MaterialSimulation::cut(const Cutter& cutter, const MaterialMove& mov
   const std::vector<ConvexPiece> cutting = pieces_of(cutter.cutting), body = pieces_of(cutter.body);
   const geometry::Lattice& lattice = stock_.lattice();
   RowMask cut_mask(scratch_[0]), body_mask(scratch_[1]);
-  rasterise(cut_mask, cutting, segments, lattice, domain_);
-  rasterise(body_mask, body, segments, lattice, domain_);
+  rasterise(cut_mask, cutting, segments, lattice, domain_, &stock_);
+  rasterise(body_mask, body, segments, lattice, domain_, &stock_);
 
   const bool rapid = move.motion == Motion::Rapid;
   Tally removed, gouge, contact;
@@ -342,7 +360,6 @@ MoveReport MaterialSimulation::deposit(const Bead& bead, const MaterialMove& mov
   if (move.process_on) {
     RowMask bead_mask(scratch_[0]), body_mask(scratch_[1]);
     rasterise(bead_mask, shape, segments, lattice, {});
-    rasterise(body_mask, body, segments, lattice, domain_);
     // Bead voxels beyond the domain are lost.
     Tally outside;
     if (!bead_mask.empty()) {
@@ -361,10 +378,13 @@ MoveReport MaterialSimulation::deposit(const Bead& bead, const MaterialMove& mov
     if (empty_ && !bead_mask.empty()) plate_ = std::max(plate_, bead_mask.box.lo.z);
     BeadLaying laying{stock_, domain_, plate_, rule, lattice, segments, {}, {}, {}};
     // The body sits above the bead: fresh material can reach it only on a falling move.
+    // The body's mask is made over the stock as the body meets it (only_over).
     if (move.to.z < move.from.z) {
       laying.lay(bead_mask);
+      rasterise(body_mask, body, segments, lattice, domain_, &stock_);
       touch(body_mask);
     } else {
+      rasterise(body_mask, body, segments, lattice, domain_, &stock_);
       touch(body_mask);
       laying.lay(bead_mask);
     }
@@ -388,7 +408,7 @@ MoveReport MaterialSimulation::deposit(const Bead& bead, const MaterialMove& mov
     RowMask mask(scratch_[0]);
     std::vector<ConvexPiece> pieces = body;
     if (rapid) pieces.insert(pieces.end(), shape.begin(), shape.end());
-    rasterise(mask, pieces, segments, lattice, domain_);
+    rasterise(mask, pieces, segments, lattice, domain_, &stock_);
     touch(mask);
     if (rapid) {
       out.rapid_contact = double(contact.voxels) * v;

@@ -1,6 +1,9 @@
 #include "toolpaths/pocket_path.hpp"
 
 #include <algorithm>
+#include <cstdint>
+#include <span>
+#include <vector>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -88,16 +91,26 @@ void PocketBuilder::stamp_run(int k) {
   SliceMask tips(x0 - R, y0 - R, x1 - x0 + 1 + 2 * R, y1 - y0 + 1 + 2 * R);
   for (const Cell& c : cells) tips.set(c.x, c.y);
   const IndexBox storage = remaining_.storage_box();
+  const int first_word = remaining_.first_word(), words = remaining_.words_per_row();
+  std::vector<std::uint64_t> row_mask(std::size_t(words > 0 ? words : 0));
   for (const auto& [radius, levels] : model_.cutter_discs) {
     const SliceMask swept = grow_by_disc(tips, radius);
-    for (int y = swept.y0(); y < swept.y0() + swept.ny(); ++y)
-      for (int x = swept.x0(); x < swept.x0() + swept.nx(); ++x) {
-        if (!swept.at(x, y)) continue;
-        for (const int t : levels) {
-          const geometry::Index3 v{x, y, k + t};
-          if (storage.contains(v) && remaining_.contains(v)) remaining_.set(v, false);
+    // Row by row: the swept cells as words of the stored row, cleared at every level.
+    for (int y = std::max(swept.y0(), storage.lo.y); y < std::min(swept.y0() + swept.ny(), storage.hi.y); ++y) {
+      std::fill(row_mask.begin(), row_mask.end(), 0);
+      bool any = false;
+      for (int x = std::max(swept.x0(), storage.lo.x); x < std::min(swept.x0() + swept.nx(), storage.hi.x); ++x)
+        if (swept.at(x, y)) {
+          row_mask[std::size_t((x >> 6) - first_word)] |= std::uint64_t{1} << (x & 63);
+          any = true;
         }
+      if (!any) continue;
+      for (const int t : levels) {
+        if (k + t < storage.lo.z || k + t >= storage.hi.z) continue;
+        const std::span<std::uint64_t> r = remaining_.row(y, k + t);
+        for (std::size_t w = 0; w < r.size(); ++w) r[w] &= ~row_mask[w];
       }
+    }
   }
   refresh_tops({{x0 - R, y0 - R, 0}, {x1 + 1 + R, y1 + 1 + R, 1}});
 }
