@@ -112,6 +112,18 @@ void rasterise(RowMask& mask, std::span<const ConvexPiece> pieces, std::span<con
       }
 }
 
+// The sweep over `stock` alone, for masks only ever intersected with it (a cut, a collision
+// test): clipped to the box its material lies in (`material`, a box holding it) and to
+// its rows with material (rasterise's only_over).
+void rasterise_over(RowMask& mask, std::span<const ConvexPiece> pieces, std::span<const Segment> segments,
+                    const geometry::Solid& stock, const IndexBox& material) {
+  const IndexBox clip = geometry::box_intersection(stock.storage_box(), material);
+  if (clip.empty())
+    mask.reset({});
+  else
+    rasterise(mask, pieces, segments, stock.lattice(), clip, &stock);
+}
+
 // Counts voxels and the box they span.
 struct Tally {
   std::int64_t voxels = 0;
@@ -271,6 +283,7 @@ MaterialSimulation::MaterialSimulation(geometry::Solid stock, std::optional<geom
   domain_ = stock_.storage_box();
   plate_ = domain_.lo.z;
   empty_ = stock_.empty();
+  material_box_ = stock_.bounding_box();
   if (domain_.empty()) throw std::invalid_argument("the stock must have a non-empty storage box (the simulated domain)");
   set_protected_region(std::move(protected_region));
   if (!(options_.arc_tolerance >= 0)) throw std::invalid_argument("arc tolerance must be >= 0");
@@ -291,8 +304,8 @@ MoveReport MaterialSimulation::cut(const Cutter& cutter, const MaterialMove& mov
   const std::vector<ConvexPiece> cutting = pieces_of(cutter.cutting), body = pieces_of(cutter.body);
   const geometry::Lattice& lattice = stock_.lattice();
   RowMask cut_mask(scratch_[0]), body_mask(scratch_[1]);
-  rasterise(cut_mask, cutting, segments, lattice, domain_, &stock_);
-  rasterise(body_mask, body, segments, lattice, domain_, &stock_);
+  rasterise_over(cut_mask, cutting, segments, stock_, material_box_);
+  rasterise_over(body_mask, body, segments, stock_, material_box_);
 
   const bool rapid = move.motion == Motion::Rapid;
   Tally removed, gouge, contact;
@@ -381,16 +394,20 @@ MoveReport MaterialSimulation::deposit(const Bead& bead, const MaterialMove& mov
     // The body's mask is made over the stock as the body meets it (only_over).
     if (move.to.z < move.from.z) {
       laying.lay(bead_mask);
-      rasterise(body_mask, body, segments, lattice, domain_, &stock_);
+      rasterise_over(body_mask, body, segments, stock_, material_box_);
       touch(body_mask);
     } else {
-      rasterise(body_mask, body, segments, lattice, domain_, &stock_);
+      rasterise_over(body_mask, body, segments, stock_, material_box_);
       touch(body_mask);
       laying.lay(bead_mask);
     }
     const Tally& added = laying.added;
     const Tally& overlap = laying.overlap;
-    if (added.voxels > 0) empty_ = false;
+    if (added.voxels > 0) {
+      empty_ = false;
+      const IndexBox grown{added.lo, {added.hi.x + 1, added.hi.y + 1, added.hi.z + 1}};
+      material_box_ = material_box_.empty() ? grown : geometry::box_union(material_box_, grown);
+    }
     out.deposited = double(added.voxels) * v;
     out.overlap = double(overlap.voxels) * v;
     out.outside = double(outside.voxels) * v;
@@ -408,7 +425,7 @@ MoveReport MaterialSimulation::deposit(const Bead& bead, const MaterialMove& mov
     RowMask mask(scratch_[0]);
     std::vector<ConvexPiece> pieces = body;
     if (rapid) pieces.insert(pieces.end(), shape.begin(), shape.end());
-    rasterise(mask, pieces, segments, lattice, domain_, &stock_);
+    rasterise_over(mask, pieces, segments, stock_, material_box_);
     touch(mask);
     if (rapid) {
       out.rapid_contact = double(contact.voxels) * v;

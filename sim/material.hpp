@@ -110,6 +110,9 @@ class MaterialSimulation {
   // empty, the first bead's lowest layer (docs/support.md, "In the simulator").
   int plate_ = 0;
   bool empty_ = true;  // no material in the stock yet
+  // A box holding all material of the stock: cuts leave it as it is, deposits grow it.
+  // Sweeps tested against material are clipped to it (most of a holder sweeps air).
+  geometry::IndexBox material_box_;
   // Reused scratch words for one move's swept voxels (instrument, body).
   std::vector<std::uint64_t> scratch_[2];
 };
