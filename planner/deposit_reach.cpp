@@ -31,6 +31,29 @@ struct ColumnFrame {
   }
 };
 
+// out[o] (o in [0, n_out), position out_first + o) = the largest in[i] (position
+// in_first + i, i in [0, n_in)) within `half` positions, -1 when none: the sliding
+// maximum of van Herk and Gil-Werman, three comparisons a position whatever the window.
+void window_max(const int* in, int in_stride, int in_first, int n_in, int half, int out_first, int n_out, int* out,
+                int out_stride, std::vector<int>& scratch) {
+  const int w = 2 * half + 1;
+  // p[k] = the input at position out_first - half + k, -1 beyond it; out[o] = max p[o .. o + w).
+  const int len = n_out + w - 1;
+  const int blocks = (len + w - 1) / w;
+  scratch.assign(std::size_t(3) * std::size_t(blocks) * std::size_t(w), -1);
+  int* p = scratch.data();
+  int* g = p + std::size_t(blocks) * std::size_t(w);  // max from the block's start
+  int* h = g + std::size_t(blocks) * std::size_t(w);  // max to the block's end
+  for (int i = 0; i < n_in; ++i) {
+    const int k = in_first + i - (out_first - half);
+    if (k >= 0 && k < len) p[k] = in[std::size_t(i) * std::size_t(in_stride)];
+  }
+  const int total = blocks * w;
+  for (int k = 0; k < total; ++k) g[k] = k % w == 0 ? p[k] : std::max(g[k - 1], p[k]);
+  for (int k = total - 1; k >= 0; --k) h[k] = k % w == w - 1 ? p[k] : std::max(h[k + 1], p[k]);
+  for (int o = 0; o < n_out; ++o) out[std::size_t(o) * std::size_t(out_stride)] = std::max(h[o], g[o + w - 1]);
+}
+
 }  // namespace
 
 std::vector<AtomSet> atoms_above(const AtomDecomposition& atoms, geometry::AxisDirection approach, int gap) {
@@ -92,6 +115,10 @@ std::vector<AtomSet> atoms_in_nozzle_reach(const AtomDecomposition& atoms, geome
       auto& column = in_column[std::size_t(v) * std::size_t(nu) + std::size_t(u)];
       for (int t = 0; t < len; ++t) {
         const int a = f.atom(atoms, u, v, t);
+        if (!column.empty() && column.back().atom == a) {  // most voxels continue a run
+          column.back().highest = t;
+          continue;
+        }
         const auto e = std::find_if(column.begin(), column.end(), [a](const Entry& x) { return x.atom == a; });
         if (e != column.end()) {
           e->highest = t;
@@ -105,7 +132,7 @@ std::vector<AtomSet> atoms_in_nozzle_reach(const AtomDecomposition& atoms, geome
   std::vector<int> highest;
   // Half the side of the square inscribed in the body's circle, in whole voxels.
   const int half = int(std::floor(nozzle.radius / std::sqrt(2.0) + 1e-9));
-  std::vector<int> row, top;
+  std::vector<int> row, top, scratch;
   for (int a = 0; a < n; ++a) {
     const Box2& b = box[std::size_t(a)];
     if (b.u1 < 0) continue;
@@ -121,20 +148,13 @@ std::vector<AtomSet> atoms_in_nozzle_reach(const AtomDecomposition& atoms, geome
           if (e.atom == a) highest[std::size_t(v - b.v0) * std::size_t(bu) + std::size_t(u - b.u0)] = e.highest;
     row.assign(std::size_t(wu) * std::size_t(wv), kNone);
     for (int v = b.v0; v <= b.v1; ++v)
-      for (int u = u0; u <= u1; ++u) {
-        int m = kNone;
-        for (int k = std::max(b.u0, u - half); k <= std::min(b.u1, u + half); ++k)
-          m = std::max(m, highest[std::size_t(v - b.v0) * std::size_t(bu) + std::size_t(k - b.u0)]);
-        row[std::size_t(v - v0) * std::size_t(wu) + std::size_t(u - u0)] = m;
-      }
+      window_max(&highest[std::size_t(v - b.v0) * std::size_t(bu)], 1, b.u0, bu, half, u0, wu,
+                 &row[std::size_t(v - v0) * std::size_t(wu)], 1, scratch);
     top.assign(row.size(), kNone);
-    for (int v = v0; v <= v1; ++v)
-      for (int u = u0; u <= u1; ++u) {
-        int m = kNone;
-        for (int k = std::max(b.v0, v - half); k <= std::min(b.v1, v + half); ++k)
-          m = std::max(m, row[std::size_t(k - v0) * std::size_t(wu) + std::size_t(u - u0)]);
-        top[std::size_t(v - v0) * std::size_t(wu) + std::size_t(u - u0)] = m;
-      }
+    const int bv = b.v1 - b.v0 + 1;
+    for (int u = u0; u <= u1; ++u)
+      window_max(&row[std::size_t(b.v0 - v0) * std::size_t(wu) + std::size_t(u - u0)], wu, b.v0, bv, half, v0, wv,
+                 &top[std::size_t(u - u0)], wu, scratch);
     // Every atom with a voxel the body over it would reach `a` from.
     for (int v = v0; v <= v1; ++v)
       for (int u = u0; u <= u1; ++u) {
@@ -166,13 +186,27 @@ DepositFooting deposit_footing(const AtomDecomposition& atoms, const geometry::S
   // The first layer's position t along the column frame (0: the domain's lowest layer).
   const int first = f.sign > 0 ? lo[f.axis] - f.lo[f.axis] : f.hi[f.axis] - hi[f.axis];
   const int nu = f.nu(), nv = f.nv();
+  auto in_region = [&](int u, int v) {
+    int c[3];
+    c[f.ua] = f.lo[f.ua] + u, c[f.va] = f.lo[f.va] + v;
+    c[f.axis] = f.sign > 0 ? f.lo[f.axis] + first : f.hi[f.axis] - 1 - first;
+    return region.contains({c[0], c[1], c[2]});
+  };
+  // Along each row of the first layer, cells of one atom in a run share their carriers'
+  // rows: the window of the run is scanned once, not once per cell (a bead's reach is
+  // tens of voxels).
+  const int u_lo = lo[f.ua] - f.lo[f.ua], u_hi = hi[f.ua] - f.lo[f.ua];
   for (int v = lo[f.va] - f.lo[f.va]; v < hi[f.va] - f.lo[f.va]; ++v)
-    for (int u = lo[f.ua] - f.lo[f.ua]; u < hi[f.ua] - f.lo[f.ua]; ++u) {
-      int c[3];
-      c[f.ua] = f.lo[f.ua] + u, c[f.va] = f.lo[f.va] + v;
-      c[f.axis] = f.sign > 0 ? f.lo[f.axis] + first : f.hi[f.axis] - 1 - first;
-      if (!region.contains({c[0], c[1], c[2]})) continue;
+    for (int u = u_lo; u < u_hi;) {
+      if (!in_region(u, v)) {
+        ++u;
+        continue;
+      }
       const int b = f.atom(atoms, u, v, first);
+      int end = u + 1;
+      while (end < u_hi && in_region(end, v) && f.atom(atoms, end, v, first) == b) ++end;
+      const int run_first = u;
+      u = end;
       if (first == 0) {
         out.kind[std::size_t(b)] = DepositFooting::OnPlate;
         continue;
@@ -183,13 +217,18 @@ DepositFooting deposit_footing(const AtomDecomposition& atoms, const geometry::S
         out.carriers[std::size_t(b)] = AtomSet(n);
       }
       AtomSet& carriers = out.carriers[std::size_t(b)];
+      const int w0 = std::max(0, run_first - reach), w1 = std::min(nu - 1, end - 1 + reach);
       for (int t = std::max(0, first - 2); t <= first; ++t)
-        for (int dv = -reach; dv <= reach; ++dv)
-          for (int du = -reach; du <= reach; ++du) {
-            if (u + du < 0 || u + du >= nu || v + dv < 0 || v + dv >= nv) continue;
-            const int a = f.atom(atoms, u + du, v + dv, t);
+        for (int dv = -reach; dv <= reach; ++dv) {
+          if (v + dv < 0 || v + dv >= nv) continue;
+          int last = -1;
+          for (int wu = w0; wu <= w1; ++wu) {
+            const int a = f.atom(atoms, wu, v + dv, t);
+            if (a == last) continue;
+            last = a;
             if (a != b) carriers.set(a);
           }
+        }
     }
   return out;
 }
