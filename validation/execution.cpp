@@ -1,8 +1,11 @@
 #include "validation/execution.hpp"
 
+#include <algorithm>
+#include <cstdint>
 #include <list>
 #include <map>
 #include <optional>
+#include <span>
 #include <utility>
 
 #include "common/error.hpp"
@@ -21,9 +24,24 @@ using geometry::Solid;
 // the domain planning looked at, so deposit beyond the raw stock's box is not lost.
 Solid on_domain(const Solid& s, const planner::PlanFile& file) {
   Solid out(file.lattice, file.domain);
-  s.for_each_voxel([&](geometry::Index3 v) {
-    if (file.domain.contains(v)) out.set(v);
-  });
+  const geometry::IndexBox& d = file.domain;
+  const geometry::IndexBox rows = geometry::box_intersection(s.storage_box(), d);
+  if (rows.empty()) return out;
+  // Word by word: both solids number words from x = 0, so words line up.
+  const int w0 = std::max(s.first_word(), out.first_word());
+  const int w1 = std::min(s.first_word() + s.words_per_row(), out.first_word() + out.words_per_row());
+  for (int z = rows.lo.z; z < rows.hi.z; ++z)
+    for (int y = rows.lo.y; y < rows.hi.y; ++y) {
+      const std::span<const std::uint64_t> from = s.row(y, z);
+      const std::span<std::uint64_t> to = out.row(y, z);
+      for (int w = w0; w < w1; ++w) {
+        // Only voxels of the domain along x: bits [a, b) of the word.
+        const int a = std::max(d.lo.x - w * 64, 0), b = std::min(d.hi.x - w * 64, 64);
+        if (a >= b) continue;
+        const std::uint64_t upper = b == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << b) - 1;
+        to[std::size_t(w - out.first_word())] = from[std::size_t(w - s.first_word())] & upper & (~std::uint64_t{0} << a);
+      }
+    }
   return out;
 }
 
