@@ -4,7 +4,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <climits>
+#include <cmath>
 #include <memory>
+#include <random>
 
 #include "planner/deposit_reach.hpp"
 #include "planner_fixtures.hpp"
@@ -91,6 +96,112 @@ TEST(AtomsInNozzleReach, AreTheAtomsTheBodyMeetsOverTheDeposit) {
 
   // A body shorter than the domain is tall: the relation does not know where it ends.
   for (const AtomSet& s : atoms_in_nozzle_reach(near.atoms, kFromAbove, {10, 5, 20})) EXPECT_TRUE(s.words().empty());
+}
+
+// Random decompositions of a small domain, seen from a few approaches, against the
+// definitions read literally, voxel pair by voxel pair.
+struct ColumnView {
+  AxisDirection approach;
+  IndexBox d;
+  // (u, v) across the column, t along it from the far side (0: the domain's lowest layer).
+  std::array<int, 3> of(Index3 p) const {
+    const int c[3] = {p.x, p.y, p.z}, lo[3] = {d.lo.x, d.lo.y, d.lo.z}, hi[3] = {d.hi.x, d.hi.y, d.hi.z};
+    const int axis = int(approach.axis), ua = (axis + 1) % 3, va = (axis + 2) % 3;
+    return {c[ua], c[va], approach.sign > 0 ? c[axis] - lo[axis] : hi[axis] - 1 - c[axis]};
+  }
+};
+
+VoxelProblem random_boxes(std::mt19937& rng, const IndexBox& domain) {
+  std::vector<VoxelPrimitive> prims;
+  Solid design(kUnit, domain);
+  auto coord = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng); };
+  for (int i = 0; i < 5; ++i) {
+    Index3 a{coord(0, domain.hi.x - 1), coord(0, domain.hi.y - 1), coord(0, domain.hi.z - 1)};
+    Index3 b{coord(0, domain.hi.x - 1), coord(0, domain.hi.y - 1), coord(0, domain.hi.z - 1)};
+    const Solid box = make_box(kUnit, {{double(std::min(a.x, b.x)), double(std::min(a.y, b.y)), double(std::min(a.z, b.z))},
+                                       {double(std::max(a.x, b.x) + 1), double(std::max(a.y, b.y) + 1),
+                                        double(std::max(a.z, b.z) + 1)}});
+    prims.push_back({"P" + std::to_string(i + 1), Mode::Additive, false, 1.0, box});
+    if (i < 2) design = unite(design, box);
+  }
+  return make_problem(prims, design, domain);
+}
+
+TEST(AtomsInNozzleReach, AgreesWithTheDefinitionVoxelPairByVoxelPairOnRandomDecompositions) {
+  std::mt19937 rng(7);
+  const IndexBox domain{{0, 0, 0}, {14, 12, 10}};
+  for (int round = 0; round < 12; ++round) {
+    const VoxelProblem vp = random_boxes(rng, domain);
+    const AxisDirection approach = std::array{kFromAbove, kFromBelow, AxisDirection{Axis::X, -1},
+                                              AxisDirection{Axis::Y, +1}}[std::size_t(round % 4)];
+    const NozzleReach nozzle{2.0 + round % 5, 1 + round % 3, 40};
+    const ColumnView view{approach, domain};
+    const int half = int(std::floor(nozzle.radius / std::sqrt(2.0) + 1e-9));
+    const auto reach = atoms_in_nozzle_reach(vp.atoms, approach, nozzle);
+    const int n = vp.atoms.atom_count();
+    std::vector<std::vector<bool>> expected(std::size_t(n), std::vector<bool>(std::size_t(n), false));
+    // `other` meets the body over `a` when a voxel of `a` lies within the body's square
+    // over a voxel of `other`, at least the standoff above it.
+    std::vector<std::pair<int, std::array<int, 3>>> voxels;
+    for (int z = domain.lo.z; z < domain.hi.z; ++z)
+      for (int y = domain.lo.y; y < domain.hi.y; ++y)
+        for (int x = domain.lo.x; x < domain.hi.x; ++x) voxels.push_back({vp.atoms.atom_at({x, y, z}), view.of({x, y, z})});
+    for (const auto& [other, p] : voxels)
+      for (const auto& [a, q] : voxels)
+        if (a != other && std::abs(q[0] - p[0]) <= half && std::abs(q[1] - p[1]) <= half && q[2] >= p[2] + nozzle.standoff)
+          expected[std::size_t(other)][std::size_t(a)] = true;
+    for (int o = 0; o < n; ++o)
+      for (int a = 0; a < n; ++a) {
+        const AtomSet& s = reach[std::size_t(o)];
+        EXPECT_EQ(!s.words().empty() && s.test(a), expected[std::size_t(o)][std::size_t(a)])
+            << "round " << round << ": atom " << a << " over atom " << o;
+      }
+  }
+}
+
+TEST(DepositFooting, AgreesWithTheDefinitionOnRandomDecompositions) {
+  std::mt19937 rng(11);
+  const IndexBox domain{{0, 0, 0}, {14, 12, 10}};
+  for (int round = 0; round < 12; ++round) {
+    const VoxelProblem vp = random_boxes(rng, domain);
+    const AxisDirection approach = std::array{kFromAbove, kFromBelow, AxisDirection{Axis::X, +1},
+                                              AxisDirection{Axis::Y, -1}}[std::size_t(round % 4)];
+    const ColumnView view{approach, domain};
+    const Solid region = unite(make_box(kUnit, {{3, 2, 4}, {9, 8, 7}}), make_box(kUnit, {{8, 5, 2}, {12, 11, 5}}));
+    const int reach = 1 + round % 3;
+    const DepositFooting f = deposit_footing(vp.atoms, region, approach, reach);
+    const int n = vp.atoms.atom_count();
+    int first = INT32_MAX;
+    region.for_each_voxel([&](Index3 p) { first = std::min(first, view.of(p)[2]); });
+    std::vector<DepositFooting::Kind> kind(std::size_t(n), DepositFooting::None);
+    std::vector<std::vector<bool>> carriers(std::size_t(n), std::vector<bool>(std::size_t(n), false));
+    region.for_each_voxel([&](Index3 p) {
+      const auto pv = view.of(p);
+      if (pv[2] != first) return;
+      const int b = vp.atoms.atom_at(p);
+      if (first == 0) {
+        kind[std::size_t(b)] = DepositFooting::OnPlate;
+        return;
+      }
+      if (kind[std::size_t(b)] != DepositFooting::OnPlate) kind[std::size_t(b)] = DepositFooting::NeedsCarrier;
+      for (int z = domain.lo.z; z < domain.hi.z; ++z)
+        for (int y = domain.lo.y; y < domain.hi.y; ++y)
+          for (int x = domain.lo.x; x < domain.hi.x; ++x) {
+            const auto q = view.of({x, y, z});
+            const int a = vp.atoms.atom_at({x, y, z});
+            if (a != b && q[2] <= first && q[2] >= first - 2 && std::abs(q[0] - pv[0]) <= reach &&
+                std::abs(q[1] - pv[1]) <= reach)
+              carriers[std::size_t(b)][std::size_t(a)] = true;
+          }
+    });
+    for (int b = 0; b < n; ++b) {
+      ASSERT_EQ(f.kind[std::size_t(b)], kind[std::size_t(b)]) << "round " << round << ", atom " << b;
+      if (kind[std::size_t(b)] != DepositFooting::NeedsCarrier) continue;
+      for (int a = 0; a < n; ++a)
+        EXPECT_EQ(f.carriers[std::size_t(b)].test(a), carriers[std::size_t(b)][std::size_t(a)])
+            << "round " << round << ": atom " << a << " under atom " << b;
+    }
+  }
 }
 
 // A block deposited over a raw stock: its first layer (z = 6) is carried by the stock
