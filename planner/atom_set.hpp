@@ -40,6 +40,40 @@ class AtomSet {
   std::vector<std::uint64_t> words_;
 };
 
+// A relation between atoms, one set per atom (what blocks a head from it, what may carry
+// it), with each set's non-zero words kept apart as well: the search asks per atom it
+// deposits whether its set meets the state, millions of times, and the sets are sparse
+// (a few atoms in thousands), so it reads only those words.
+class AtomRelation {
+ public:
+  AtomRelation() = default;
+  explicit AtomRelation(std::vector<AtomSet> sets) : sets_(std::move(sets)) {
+    begin_.reserve(sets_.size() + 1);
+    for (const AtomSet& s : sets_) {
+      begin_.push_back(std::uint32_t(index_.size()));
+      const auto& w = s.words();
+      for (std::size_t k = 0; k < w.size(); ++k)
+        if (w[k]) index_.push_back(std::uint32_t(k)), words_.push_back(w[k]);
+    }
+    begin_.push_back(std::uint32_t(index_.size()));
+  }
+  std::size_t size() const { return sets_.size(); }
+  // The set of atom a (no words: empty).
+  const AtomSet& operator[](std::size_t a) const { return sets_[a]; }
+  // Whether the set of atom a holds a member of `state` (words of an AtomSet).
+  bool meets(std::size_t a, const std::vector<std::uint64_t>& state) const {
+    for (std::uint32_t e = begin_[a]; e < begin_[a + 1]; ++e)
+      if (words_[e] & state[index_[e]]) return true;
+    return false;
+  }
+
+ private:
+  std::vector<AtomSet> sets_;
+  std::vector<std::uint32_t> begin_;  // per atom, where its non-zero words start
+  std::vector<std::uint32_t> index_;  // their word indices
+  std::vector<std::uint64_t> words_;  // and the words
+};
+
 struct AtomSetHash {
   std::size_t operator()(const AtomSet& c) const {
     std::uint64_t h = 0x9E3779B97F4A7C15ull;

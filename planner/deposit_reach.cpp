@@ -177,10 +177,13 @@ DepositFooting deposit_footing(const AtomDecomposition& atoms, const geometry::S
   const int n = atoms.atom_count();
   DepositFooting out;
   out.kind.assign(std::size_t(n), DepositFooting::None);
-  out.carriers.resize(std::size_t(n));
+  std::vector<AtomSet> carriers_of(static_cast<std::size_t>(n));
   const geometry::IndexBox& d = atoms.domain();
   const geometry::IndexBox bb = geometry::box_intersection(region.bounding_box(), d);
-  if (bb.empty()) return out;
+  if (bb.empty()) {
+    out.carriers = AtomRelation(std::move(carriers_of));
+    return out;
+  }
   const ColumnFrame f(d, approach);
   const int lo[3] = {bb.lo.x, bb.lo.y, bb.lo.z}, hi[3] = {bb.hi.x, bb.hi.y, bb.hi.z};
   // The first layer's position t along the column frame (0: the domain's lowest layer).
@@ -214,9 +217,9 @@ DepositFooting deposit_footing(const AtomDecomposition& atoms, const geometry::S
       if (out.kind[std::size_t(b)] == DepositFooting::OnPlate) continue;
       if (out.kind[std::size_t(b)] == DepositFooting::None) {
         out.kind[std::size_t(b)] = DepositFooting::NeedsCarrier;
-        out.carriers[std::size_t(b)] = AtomSet(n);
+        carriers_of[std::size_t(b)] = AtomSet(n);
       }
-      AtomSet& carriers = out.carriers[std::size_t(b)];
+      AtomSet& carriers = carriers_of[std::size_t(b)];
       const int w0 = std::max(0, run_first - reach), w1 = std::min(nu - 1, end - 1 + reach);
       for (int t = std::max(0, first - 2); t <= first; ++t)
         for (int dv = -reach; dv <= reach; ++dv) {
@@ -230,6 +233,7 @@ DepositFooting deposit_footing(const AtomDecomposition& atoms, const geometry::S
           }
         }
     }
+  out.carriers = AtomRelation(std::move(carriers_of));
   return out;
 }
 

@@ -171,9 +171,9 @@ const config::AdditiveHead* deposition_head(const config::Machine& machine, cons
 // Per head and setup, which present atoms keep the head from an atom: over it in its
 // column, or in the nozzle's way (deposit_reach.hpp); setups that share an approach share
 // the relation.
-std::shared_ptr<const std::vector<AtomSet>> reach_limits(const PlanningResult& r, const config::Machine& machine,
-                                                         const Primitive& prim,
-                                                         std::map<std::pair<int, int>, std::shared_ptr<const std::vector<AtomSet>>>& cache) {
+std::shared_ptr<const AtomRelation> reach_limits(const PlanningResult& r, const config::Machine& machine,
+                                                const Primitive& prim,
+                                                std::map<std::pair<int, int>, std::shared_ptr<const AtomRelation>>& cache) {
   const config::AdditiveHead* head = deposition_head(machine, prim);
   const config::Setup* setup = head ? machine.find_setup(prim.setup) : nullptr;
   if (!setup) return nullptr;
@@ -196,7 +196,7 @@ std::shared_ptr<const std::vector<AtomSet>> reach_limits(const PlanningResult& r
       for (std::size_t w = 0; w < blocked[a].words().size(); ++w) blocked[a].words()[w] |= touched[a].words()[w];
     }
   }
-  slot = std::make_shared<const std::vector<AtomSet>>(std::move(blocked));
+  slot = std::make_shared<const AtomRelation>(std::move(blocked));
   return slot;
 }
 
@@ -220,7 +220,7 @@ std::shared_ptr<const DepositFooting> first_layer_carriers(const PlanningResult&
 // The symbolic problem the search runs on: atoms with volumes and classes, primitives as
 // sets of atoms, deposits with what the plan's state may rule out.
 PlanningProblem symbolic_problem(const PlanningResult& r, const config::Machine& machine, int max_uses) {
-  std::map<std::pair<int, int>, std::shared_ptr<const std::vector<AtomSet>>> reach_cache;
+  std::map<std::pair<int, int>, std::shared_ptr<const AtomRelation>> reach_cache;
   PlanningProblem p;
   // Cost factors are normalised so that parts compare; minutes and money are read as such.
   const bool factors = r.objective == config::Objective::CostFactor;

@@ -29,7 +29,7 @@ struct AtomSpec {
 struct DepositFooting {
   enum Kind : std::uint8_t { None, OnPlate, NeedsCarrier };  // per atom
   std::vector<Kind> kind;
-  std::vector<AtomSet> carriers;  // per NeedsCarrier atom: the atoms that may carry it
+  AtomRelation carriers;  // per NeedsCarrier atom: the atoms that may carry it
 };
 
 struct PrimitiveSpec {
@@ -46,7 +46,7 @@ struct PrimitiveSpec {
   // Additive only: for each atom, the atoms that, present, put part of it out of the head's
   // reach (planner/deposit_reach.hpp). The action cannot be taken in a state that holds one
   // of them over an atom it would deposit. Null: nothing limits it.
-  std::shared_ptr<const std::vector<AtomSet>> blocked_by;
+  std::shared_ptr<const AtomRelation> blocked_by;
   // Additive only: in a state that holds material, an atom of the first layer it would
   // deposit needs a carrier present; null: nothing limits it.
   std::shared_ptr<const DepositFooting> footing;

@@ -101,33 +101,34 @@ AtomSet mapped(const AtomSet& set, const std::vector<int>& group, int groups) {
   return out;
 }
 
-using Reach = std::shared_ptr<const std::vector<AtomSet>>;
+using Reach = std::shared_ptr<const AtomRelation>;
 using Footing = std::shared_ptr<const DepositFooting>;
 
-Reach mapped_reach(const std::vector<AtomSet>& blocked_by, const std::vector<int>& group, int groups) {
-  auto out = std::make_shared<std::vector<AtomSet>>(std::size_t(groups), AtomSet(groups));
+Reach mapped_reach(const AtomRelation& blocked_by, const std::vector<int>& group, int groups) {
+  std::vector<AtomSet> out(std::size_t(groups), AtomSet{groups});
   // A group is out of reach when material lies over any of its atoms.
   for (std::size_t a = 0; a < blocked_by.size() && a < group.size(); ++a)
     if (group[a] >= 0) {
-      auto& into = (*out)[std::size_t(group[a])].words();
+      auto& into = out[std::size_t(group[a])].words();
       const AtomSet over = mapped(blocked_by[a], group, groups);
       for (std::size_t w = 0; w < into.size(); ++w) into[w] |= over.words()[w];
     }
-  return out;
+  return std::make_shared<const AtomRelation>(std::move(out));
 }
 
 Footing mapped_footing(const DepositFooting& footing, const std::vector<int>& group, int groups) {
   auto out = std::make_shared<DepositFooting>();
   out->kind.assign(std::size_t(groups), DepositFooting::None);
-  out->carriers.assign(std::size_t(groups), AtomSet(groups));
+  std::vector<AtomSet> carriers(std::size_t(groups), AtomSet{groups});
   // The atoms of a group that need a carrier all have the same ones (group_atoms).
   for (std::size_t a = 0; a < footing.kind.size() && a < group.size(); ++a) {
     if (group[a] < 0 || footing.kind[a] == DepositFooting::None) continue;
     auto& kind = out->kind[std::size_t(group[a])];
     if (kind != DepositFooting::NeedsCarrier) kind = footing.kind[a];
     if (footing.kind[a] == DepositFooting::NeedsCarrier && a < footing.carriers.size())
-      out->carriers[std::size_t(group[a])] = mapped(footing.carriers[a], group, groups);
+      carriers[std::size_t(group[a])] = mapped(footing.carriers[a], group, groups);
   }
+  out->carriers = AtomRelation(std::move(carriers));
   return out;
 }
 

@@ -23,14 +23,11 @@ double volume_of_bits(const PlanningProblem& p, const std::vector<std::uint64_t>
 }
 
 // Whether material in `state` lies over an atom of `deposited` out of the head's reach.
-bool blocked(const std::vector<AtomSet>& blocked_by, const AtomSet& state, const std::vector<std::uint64_t>& deposited) {
+bool blocked(const AtomRelation& blocked_by, const AtomSet& state, const std::vector<std::uint64_t>& deposited) {
   const auto& s = state.words();
   for (std::size_t w = 0; w < deposited.size(); ++w)
-    for (std::uint64_t b = deposited[w]; b; b &= b - 1) {
-      const auto& over = blocked_by[w * 64 + std::size_t(std::countr_zero(b))].words();
-      for (std::size_t k = 0; k < over.size(); ++k)
-        if (over[k] & s[k]) return true;
-    }
+    for (std::uint64_t b = deposited[w]; b; b &= b - 1)
+      if (blocked_by.meets(w * 64 + std::size_t(std::countr_zero(b)), s)) return true;
   return false;
 }
 
@@ -43,10 +40,7 @@ bool floating(const DepositFooting& footing, const AtomSet& state, const std::ve
     for (std::uint64_t b = deposited[w]; b; b &= b - 1) {
       const std::size_t atom = w * 64 + std::size_t(std::countr_zero(b));
       if (footing.kind[atom] != DepositFooting::NeedsCarrier) continue;
-      const auto& carriers = footing.carriers[atom].words();
-      bool carried = false;
-      for (std::size_t k = 0; k < carriers.size() && !carried; ++k) carried = (carriers[k] & s[k]) != 0;
-      if (!carried) return true;
+      if (!footing.carriers.meets(atom, s)) return true;
     }
   return false;
 }

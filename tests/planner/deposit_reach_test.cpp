@@ -37,8 +37,8 @@ int atom_at(const VoxelProblem& vp, int z) { return vp.atoms.atom_at({1, 0, z});
 VoxelProblem column(AxisDirection lower_from, AxisDirection upper_from) {
   VoxelProblem vp = make_problem({{"lower", Mode::Additive, false, 1.0, slab(0, 6)}, {"upper", Mode::Additive, false, 1.0, slab(4, 10)}},
                                  slab(0, 10), kDomain);
-  vp.problem.primitives[0].blocked_by = std::make_shared<const std::vector<AtomSet>>(atoms_above(vp.atoms, lower_from, 1));
-  vp.problem.primitives[1].blocked_by = std::make_shared<const std::vector<AtomSet>>(atoms_above(vp.atoms, upper_from, 1));
+  vp.problem.primitives[0].blocked_by = std::make_shared<const AtomRelation>(atoms_above(vp.atoms, lower_from, 1));
+  vp.problem.primitives[1].blocked_by = std::make_shared<const AtomRelation>(atoms_above(vp.atoms, upper_from, 1));
   return vp;
 }
 

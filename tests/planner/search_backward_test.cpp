@@ -41,18 +41,20 @@ PlanningProblem random_problem(std::mt19937& rng, int n) {
       if (rng() % 2) s.atoms.set(a);
     s.tool = "T" + std::to_string(rng() % 2);
     if (s.mode == Mode::Additive && rng() % 3 == 0) {
-      auto reach = std::make_shared<std::vector<AtomSet>>(std::size_t(atoms), AtomSet(atoms));
-      for (auto& over : *reach)
+      std::vector<AtomSet> reach(std::size_t(atoms), AtomSet{atoms});
+      for (auto& over : reach)
         if (rng() % 3 == 0) over.set(int(rng() % unsigned(atoms)));
-      s.blocked_by = reach;
+      s.blocked_by = std::make_shared<const AtomRelation>(std::move(reach));
     }
     if (s.mode == Mode::Additive && rng() % 3 == 0) {
       auto footing = std::make_shared<DepositFooting>();
+      std::vector<AtomSet> carriers;
       for (int a = 0; a < atoms; ++a) {
         footing->kind.push_back(rng() % 3 == 0 ? DepositFooting::NeedsCarrier : DepositFooting::OnPlate);
-        footing->carriers.emplace_back(atoms);
-        footing->carriers.back().set(int(rng() % unsigned(atoms)));
+        carriers.emplace_back(atoms);
+        carriers.back().set(int(rng() % unsigned(atoms)));
       }
+      footing->carriers = AtomRelation(std::move(carriers));
       s.footing = footing;
     }
     p.primitives.push_back(std::move(s));
@@ -111,9 +113,9 @@ TEST(SearchReductions, AtomsMergeIntoOneOnlyWithWhatBlocksEachOfThem) {
   p.atoms = {{5, true, false}, {5, true, false}, {2, true, false}};
   p.primitives = {primitive("Base", Mode::Additive, 1.0, 3, {2}), primitive("P2", Mode::Additive, 0.5, 3, {0, 1}),
                   primitive("P3", Mode::Additive, 2.0, 3, {0, 1})};
-  auto reach = std::make_shared<std::vector<AtomSet>>(3, AtomSet(3));
-  (*reach)[1].set(2);
-  p.primitives[1].blocked_by = reach;
+  std::vector<AtomSet> reach(3, AtomSet{3});
+  reach[1].set(2);
+  p.primitives[1].blocked_by = std::make_shared<const AtomRelation>(std::move(reach));
   const Reduction r = reduce(p);
   EXPECT_EQ(r.problem.atoms.size(), 2u);
   for (SearchDirection direction : {SearchDirection::Forward, SearchDirection::Backward}) {
