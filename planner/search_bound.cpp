@@ -251,11 +251,33 @@ LowerBound::SideShares LowerBound::side_effects(const AtomSet& state, const Rate
     }
     side[i] = c;
   }
-  // Some primitive must change each needed atom: the dearest such obligation counts.
-  auto least = [&](const std::vector<int>& suppliers) {
+  // Per list, the volume of its atoms that are wrong: the first of its suppliers a
+  // completion uses changes all of them (no other primitive holds them), at its own rate.
+  std::vector<double> wrong(lists_.size(), 0);
+  for (std::size_t w = 0; w < s.size(); ++w) {
+    for (std::uint64_t b = must_in_[w] & ~s[w]; b; b &= b - 1) {
+      const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
+      wrong[std::size_t(adder_list_[a])] += p_.atoms[a].volume;
+    }
+    for (std::uint64_t b = must_out_[w] & s[w]; b; b &= b - 1) {
+      const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
+      wrong[std::size_t(remover_list_[a])] += p_.atoms[a].volume;
+    }
+  }
+  // Some primitive must change each needed atom: the first of the list's suppliers used
+  // pays its side effects and, beyond the cheapest rate the atom part charged, its own rate
+  // on the list's wrong atoms (not when it falls short: then it may change only some). The
+  // dearest such obligation counts.
+  auto least = [&](std::size_t l) {
+    const std::vector<int>& suppliers = lists_[l];
+    const double cheapest = r.cheapest(suppliers);
     double best = kInfinity;
-    for (int i : suppliers)
-      if (r.allowed[std::size_t(i)]) best = std::min(best, side[std::size_t(i)]);
+    for (int i : suppliers) {
+      if (!r.allowed[std::size_t(i)]) continue;
+      const PrimitiveSpec& prim = p_.primitives[std::size_t(i)];
+      const double dearer = prim.falls_short.words().empty() ? (prim.cost_per_mm3 - cheapest) * wrong[l] : 0.0;
+      best = std::min(best, side[std::size_t(i)] + dearer);
+    }
     return best;
   };
   // Adders and removers are never in one list (a list is of one mode), so each needed list
@@ -265,7 +287,7 @@ LowerBound::SideShares LowerBound::side_effects(const AtomSet& state, const Rate
   for (std::size_t l = 0; l < lists_.size(); ++l) {
     if (!needed[l] || lists_[l].empty()) continue;
     const bool adds = p_.primitives[std::size_t(lists_[l].front())].mode == Mode::Additive;
-    (adds ? add : remove) = std::max(adds ? add : remove, least(lists_[l]));
+    (adds ? add : remove) = std::max(adds ? add : remove, least(l));
   }
   return {add, remove};
 }
