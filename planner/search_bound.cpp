@@ -228,29 +228,32 @@ LowerBound::SideShares LowerBound::side_effects(const AtomSet& state, const Rate
   // The rates looked up once per list of suppliers, and what changing each atom costs.
   std::vector<double> rate(lists_.size());
   for (std::size_t l = 0; l < lists_.size(); ++l) rate[l] = r.cheapest(lists_[l]);
-  std::vector<double> deposited(p_.atoms.size()), removed(p_.atoms.size());
-  for (std::size_t a = 0; a < std::size_t(atoms_); ++a) {
-    const double in = rate[std::size_t(adder_list_[a])], out = rate[std::size_t(remover_list_[a])];
-    const AtomSpec& atom = p_.atoms[a];
-    deposited[a] = atom.volume * (in + (atom.must_out ? out : 0));
-    removed[a] = atom.volume * (out + (atom.must_in ? in : 0));
+  // An atom is held by exactly the primitives of its supplier lists, so what it costs is
+  // summed per list once and each primitive adds up its lists: one pass over the atoms
+  // instead of one per primitive.
+  std::vector<double> per_list(lists_.size(), 0);
+  for (std::size_t w = 0; w < s.size(); ++w) {
+    const std::uint64_t valid = w + 1 < s.size() || atoms_ % 64 == 0 ? ~std::uint64_t{0} : (std::uint64_t{1} << (atoms_ % 64)) - 1;
+    for (std::uint64_t b = ~s[w] & ~must_in_[w] & valid; b; b &= b - 1) {  // deposited, removed again when must-out
+      const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
+      const AtomSpec& atom = p_.atoms[a];
+      const std::size_t l = std::size_t(adder_list_[a]);
+      if (lists_[l].empty()) continue;
+      per_list[l] += atom.volume * (rate[l] + (atom.must_out ? rate[std::size_t(remover_list_[a])] : 0));
+    }
+    for (std::uint64_t b = s[w] & ~must_out_[w] & valid; b; b &= b - 1) {  // removed, deposited again when must-in
+      const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
+      const AtomSpec& atom = p_.atoms[a];
+      const std::size_t l = std::size_t(remover_list_[a]);
+      if (lists_[l].empty()) continue;
+      per_list[l] += atom.volume * (rate[l] + (atom.must_in ? rate[std::size_t(adder_list_[a])] : 0));
+    }
   }
   std::vector<double> side(p_.primitives.size(), 0);
-  for (std::size_t i = 0; i < p_.primitives.size(); ++i) {
-    if (!r.allowed[i]) continue;
-    const PrimitiveSpec& prim = p_.primitives[i];
-    const bool adds = prim.mode == Mode::Additive;
-    const auto& pa = prim.atoms.words();
-    double c = 0;
-    for (std::size_t w = 0; w < s.size(); ++w) {
-      const std::uint64_t touched = adds ? pa[w] & ~s[w] & ~must_in_[w] : pa[w] & s[w] & ~must_out_[w];
-      for (std::uint64_t b = touched; b; b &= b - 1) {
-        const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
-        c += adds ? deposited[a] : removed[a];
-      }
-    }
-    side[i] = c;
-  }
+  for (std::size_t l = 0; l < lists_.size(); ++l)
+    if (per_list[l] != 0)
+      for (int i : lists_[l]) side[std::size_t(i)] += per_list[l];
+  const std::vector<char> needed = needed_lists(state);
   // Per list, the volume of its atoms that are wrong: the first of its suppliers a
   // completion uses changes all of them (no other primitive holds them), at its own rate.
   std::vector<double> wrong(lists_.size(), 0);
@@ -283,7 +286,6 @@ LowerBound::SideShares LowerBound::side_effects(const AtomSet& state, const Rate
   // Adders and removers are never in one list (a list is of one mode), so each needed list
   // is an obligation of one kind.
   double add = 0, remove = 0;
-  const std::vector<char> needed = needed_lists(state);
   for (std::size_t l = 0; l < lists_.size(); ++l) {
     if (!needed[l] || lists_[l].empty()) continue;
     const bool adds = p_.primitives[std::size_t(lists_[l].front())].mode == Mode::Additive;
