@@ -158,19 +158,33 @@ LowerBound::AtomShares LowerBound::atom_part(const AtomSet& state, const Rates& 
 // before it.
 double LowerBound::removals_with_design_cut(const AtomSet& state, const Rates& r) const {
   const auto& s = state.words();
-  // Each allowed removal's design share in this state.
+  // Each allowed removal's design share in this state: a must-in atom present is cut by
+  // exactly the removals of its remover list, so its price is summed per list once.
+  std::vector<double> per_list(lists_.size(), 0);
+  for (std::size_t w = 0; w < s.size(); ++w)
+    for (std::uint64_t b = s[w] & must_in_[w]; b; b &= b - 1) {
+      const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
+      per_list[std::size_t(remover_list_[a])] += r.deposit(a) * p_.atoms[a].volume;
+    }
+  std::vector<double> cut_share(p_.primitives.size(), 0);
+  for (std::size_t l = 0; l < lists_.size(); ++l)
+    if (per_list[l] != 0)
+      for (int i : lists_[l]) cut_share[std::size_t(i)] += per_list[l];
   std::vector<std::pair<double, int>> shares;
   for (std::size_t i = 0; i < p_.primitives.size(); ++i) {
     const PrimitiveSpec& prim = p_.primitives[i];
     if (prim.mode != Mode::Subtractive || !r.allowed[i]) continue;
-    const auto& pa = prim.atoms.words();
-    const auto& short_of = prim.falls_short.words();
-    double share = 0;
-    for (std::size_t w = 0; w < s.size(); ++w) {
-      const std::uint64_t cut = pa[w] & s[w] & must_in_[w] & ~(w < short_of.size() ? short_of[w] : 0);
-      for (std::uint64_t b = cut; b; b &= b - 1) {
-        const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
-        share += r.deposit(a) * p_.atoms[a].volume;
+    double share = cut_share[i];
+    if (!prim.falls_short.words().empty()) {  // not what it was seen not to cut
+      const auto& pa = prim.atoms.words();
+      const auto& short_of = prim.falls_short.words();
+      share = 0;
+      for (std::size_t w = 0; w < s.size(); ++w) {
+        const std::uint64_t cut = pa[w] & s[w] & must_in_[w] & ~(w < short_of.size() ? short_of[w] : 0);
+        for (std::uint64_t b = cut; b; b &= b - 1) {
+          const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
+          share += r.deposit(a) * p_.atoms[a].volume;
+        }
       }
     }
     shares.emplace_back(share, int(i));
