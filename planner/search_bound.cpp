@@ -32,15 +32,23 @@ std::vector<int> ids_of(const PlanningProblem& p, bool setups) {
 // Which primitives may still be used, and per atom the cheapest rate at which one of them
 // deposits (or removes) it, looked up when asked (usually the first in the list).
 struct LowerBound::Rates {
+  Rates(const LowerBound& b, std::vector<bool> usable) : bound(b), allowed(std::move(usable)), rate(b.lists_.size()) {
+    // Per supplier list (cheapest first) the rate of its first allowed member: every share
+    // of the bound asks for these, per atom, many times over.
+    for (std::size_t l = 0; l < b.lists_.size(); ++l) {
+      rate[l] = kInfinity;
+      for (int i : b.lists_[l])
+        if (allowed[std::size_t(i)]) {
+          rate[l] = b.p_.primitives[std::size_t(i)].cost_per_mm3;
+          break;
+        }
+    }
+  }
   const LowerBound& bound;
   std::vector<bool> allowed;
-  double cheapest(const std::vector<int>& suppliers) const {
-    for (int i : suppliers)
-      if (allowed[std::size_t(i)]) return bound.p_.primitives[std::size_t(i)].cost_per_mm3;
-    return kInfinity;
-  }
-  double deposit(std::size_t a) const { return cheapest(bound.adders_[a]); }
-  double remove(std::size_t a) const { return cheapest(bound.removers_[a]); }
+  std::vector<double> rate;  // per list
+  double deposit(std::size_t a) const { return rate[std::size_t(bound.adder_list_[a])]; }
+  double remove(std::size_t a) const { return rate[std::size_t(bound.remover_list_[a])]; }
 };
 
 LowerBound::LowerBound(const PlanningProblem& p)
@@ -240,8 +248,7 @@ LowerBound::SideShares LowerBound::side_effects(const AtomSet& state, const Rate
   // one, present atoms that are not must-out (removed, and deposited again when must-in)
   // for a subtractive one.
   // The rates looked up once per list of suppliers, and what changing each atom costs.
-  std::vector<double> rate(lists_.size());
-  for (std::size_t l = 0; l < lists_.size(); ++l) rate[l] = r.cheapest(lists_[l]);
+  const std::vector<double>& rate = r.rate;
   // An atom is held by exactly the primitives of its supplier lists, so what it costs is
   // summed per list once and each primitive adds up its lists: one pass over the atoms
   // instead of one per primitive.
@@ -287,7 +294,7 @@ LowerBound::SideShares LowerBound::side_effects(const AtomSet& state, const Rate
   // dearest such obligation counts.
   auto least = [&](std::size_t l) {
     const std::vector<int>& suppliers = lists_[l];
-    const double cheapest = r.cheapest(suppliers);
+    const double cheapest = r.rate[l];
     double best = kInfinity;
     for (int i : suppliers) {
       if (!r.allowed[std::size_t(i)]) continue;
