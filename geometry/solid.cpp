@@ -286,7 +286,35 @@ Solid rotate_quarter_turns(const Solid& a, Axis axis, int quarter_turns) {
   const IndexBox to{{std::min(p.x, q.x), std::min(p.y, q.y), std::min(p.z, q.z)},
                     {std::max(p.x, q.x) + 1, std::max(p.y, q.y) + 1, std::max(p.z, q.z) + 1}};
   Solid out(a.lattice(), to);
-  a.for_each_voxel([&](Index3 v) { out.set(map(v)); });
+  // The map is affine: v -> o + v.x ex + v.y ey + v.z ez, each e a signed unit vector.
+  const Index3 o = map({0, 0, 0});
+  auto minus_o = [&](Index3 v) { return Index3{v.x - o.x, v.y - o.y, v.z - o.z}; };
+  const Index3 ex = minus_o(map({1, 0, 0})), ey = minus_o(map({0, 1, 0})), ez = minus_o(map({0, 0, 1}));
+  const IndexBox rows = a.storage_box();
+  const int a_first = a.first_word(), out_first = out.first_word();
+  const int out_words = out.words_per_row();
+  for (int z = rows.lo.z; z < rows.hi.z; ++z)
+    for (int y = rows.lo.y; y < rows.hi.y; ++y) {
+      const std::span<const std::uint64_t> from_row = a.row(y, z);
+      // Where voxel (x, y, z) goes: base + x ex.
+      const Index3 base{o.x + y * ey.x + z * ez.x, o.y + y * ey.y + z * ez.y, o.z + y * ey.z + z * ez.z};
+      if (ex.x == 1 && ex.y == 0 && ex.z == 0) {
+        // About X: the row lands whole on one row, its words where they were.
+        bool any = false;
+        for (const std::uint64_t w : from_row) any = any || w;
+        if (!any) continue;
+        const std::span<std::uint64_t> to_row = out.row(base.y, base.z);
+        for (int w = std::max(a_first, out_first); w < std::min(a_first + int(from_row.size()), out_first + out_words); ++w)
+          to_row[std::size_t(w - out_first)] = from_row[std::size_t(w - a_first)];
+        continue;
+      }
+      for (std::size_t w = 0; w < from_row.size(); ++w)
+        for (std::uint64_t bits = from_row[w]; bits; bits &= bits - 1) {
+          const int x = (a_first + int(w)) * Solid::kWordBits + std::countr_zero(bits);
+          const Index3 t{base.x + x * ex.x, base.y + x * ex.y, base.z + x * ex.z};
+          out.row(t.y, t.z)[std::size_t((t.x >> 6) - out_first)] |= std::uint64_t{1} << (t.x & 63);
+        }
+    }
   return out;
 }
 

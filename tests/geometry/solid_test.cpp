@@ -129,5 +129,21 @@ TEST(Solid, FourQuarterTurnsAreTheIdentityAndTwoAreAHalfTurn) {
   }
 }
 
+TEST(Solid, QuarterTurnsMoveEveryVoxelWhereTheRotationTakesItsCentre) {
+  std::mt19937 rng(5);
+  const Solid s = random_solid(rng, {{-70, -5, -2}, {9, 7, 66}}, 0.15);
+  for (Axis axis : {Axis::X, Axis::Y, Axis::Z})
+    for (int turns = 1; turns <= 3; ++turns) {
+      VoxelSet expected;
+      for (const auto& [x, y, z] : voxels_of(s)) {
+        Index3 v{x, y, z};
+        for (int t = 0; t < turns; ++t)  // a right-handed quarter turn of the centre (v + 0.5)
+          v = axis == Axis::X ? Index3{v.x, -v.z - 1, v.y} : axis == Axis::Y ? Index3{v.z, v.y, -v.x - 1} : Index3{-v.y - 1, v.x, v.z};
+        expected.insert({v.x, v.y, v.z});
+      }
+      EXPECT_EQ(voxels_of(rotate_quarter_turns(s, axis, turns)), expected) << int(axis) << " " << turns;
+    }
+}
+
 }  // namespace
 }  // namespace hybridctl::geometry
