@@ -101,10 +101,11 @@ Solid voxelize_exact_scan(const TriangleMesh& mesh, const Lattice& lattice, cons
           out.set_run(domain.lo.y + jj, k, i0, i1);
         }
       }
-      const int done = ++slices_done;
       if (progress) {
+        // Counted under the lock: counted outside, a thread could report a count below one
+        // another thread reported before it (progress must not go back).
         std::lock_guard lock(progress_mutex);
-        progress(double(done) / nz);
+        progress(double(++slices_done) / nz);
       }
     }
   });
