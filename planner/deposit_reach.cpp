@@ -5,6 +5,10 @@
 #include <cmath>
 #include <cstdint>
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 namespace hybridctl::planner {
 
 namespace {
@@ -129,46 +133,65 @@ std::vector<AtomSet> atoms_in_nozzle_reach(const AtomDecomposition& atoms, geome
         b.u0 = std::min(b.u0, u), b.v0 = std::min(b.v0, v), b.u1 = std::max(b.u1, u), b.v1 = std::max(b.v1, v);
       }
     }
-  std::vector<int> highest;
   // Half the side of the square inscribed in the body's circle, in whole voxels.
   const int half = int(std::floor(nozzle.radius / std::sqrt(2.0) + 1e-9));
-  std::vector<int> row, top, scratch;
-  for (int a = 0; a < n; ++a) {
-    const Box2& b = box[std::size_t(a)];
-    if (b.u1 < 0) continue;
-    // The highest voxel of `a` within the square around each column (a separable max).
-    const int u0 = std::max(0, b.u0 - half), u1 = std::min(nu - 1, b.u1 + half);
-    const int v0 = std::max(0, b.v0 - half), v1 = std::min(nv - 1, b.v1 + half);
-    const int wu = u1 - u0 + 1, wv = v1 - v0 + 1;
-    const int bu = b.u1 - b.u0 + 1;
-    highest.assign(std::size_t(bu) * std::size_t(b.v1 - b.v0 + 1), kNone);
-    for (int v = b.v0; v <= b.v1; ++v)
-      for (int u = b.u0; u <= b.u1; ++u)
-        for (const Entry& e : in_column[std::size_t(v) * std::size_t(nu) + std::size_t(u)])
-          if (e.atom == a) highest[std::size_t(v - b.v0) * std::size_t(bu) + std::size_t(u - b.u0)] = e.highest;
-    row.assign(std::size_t(wu) * std::size_t(wv), kNone);
-    for (int v = b.v0; v <= b.v1; ++v)
-      window_max(&highest[std::size_t(v - b.v0) * std::size_t(bu)], 1, b.u0, bu, half, u0, wu,
-                 &row[std::size_t(v - v0) * std::size_t(wu)], 1, scratch);
-    top.assign(row.size(), kNone);
-    const int bv = b.v1 - b.v0 + 1;
-    for (int u = u0; u <= u1; ++u)
-      window_max(&row[std::size_t(b.v0 - v0) * std::size_t(wu) + std::size_t(u - u0)], wu, b.v0, bv, half, v0, wv,
-                 &top[std::size_t(u - u0)], wu, scratch);
-    // Every atom with a voxel the body over it would reach `a` from.
-    for (int v = v0; v <= v1; ++v)
-      for (int u = u0; u <= u1; ++u) {
-        const int t = top[std::size_t(v - v0) * std::size_t(wu) + std::size_t(u - u0)];
-        if (t == kNone) continue;
-        for (const Entry& e : in_column[std::size_t(v) * std::size_t(nu) + std::size_t(u)]) {
-          const int other = e.atom;
-          if (other == a || t < e.lowest + nozzle.standoff) continue;
-          AtomSet& s = reach[std::size_t(other)];
-          if (s.words().empty()) s = AtomSet(n);
-          s.set(a);
+  // The atoms are independent: in parallel, each thread with its own relation (merged
+  // after) and scratch.
+  struct Local {
+    std::vector<AtomSet> reach;
+    std::vector<int> highest, row, top, scratch;
+  };
+  tbb::enumerable_thread_specific<Local> locals([n] { return Local{std::vector<AtomSet>(std::size_t(n)), {}, {}, {}, {}}; });
+  tbb::parallel_for(tbb::blocked_range<int>(0, n, 16), [&](const tbb::blocked_range<int>& range) {
+    Local& l = locals.local();
+    for (int a = range.begin(); a != range.end(); ++a) {
+      const Box2& b = box[std::size_t(a)];
+      if (b.u1 < 0) continue;
+      // The highest voxel of `a` within the square around each column (a separable max).
+      const int u0 = std::max(0, b.u0 - half), u1 = std::min(nu - 1, b.u1 + half);
+      const int v0 = std::max(0, b.v0 - half), v1 = std::min(nv - 1, b.v1 + half);
+      const int wu = u1 - u0 + 1, wv = v1 - v0 + 1;
+      const int bu = b.u1 - b.u0 + 1;
+      l.highest.assign(std::size_t(bu) * std::size_t(b.v1 - b.v0 + 1), kNone);
+      for (int v = b.v0; v <= b.v1; ++v)
+        for (int u = b.u0; u <= b.u1; ++u)
+          for (const Entry& e : in_column[std::size_t(v) * std::size_t(nu) + std::size_t(u)])
+            if (e.atom == a) l.highest[std::size_t(v - b.v0) * std::size_t(bu) + std::size_t(u - b.u0)] = e.highest;
+      l.row.assign(std::size_t(wu) * std::size_t(wv), kNone);
+      for (int v = b.v0; v <= b.v1; ++v)
+        window_max(&l.highest[std::size_t(v - b.v0) * std::size_t(bu)], 1, b.u0, bu, half, u0, wu,
+                   &l.row[std::size_t(v - v0) * std::size_t(wu)], 1, l.scratch);
+      l.top.assign(l.row.size(), kNone);
+      const int bv = b.v1 - b.v0 + 1;
+      for (int u = u0; u <= u1; ++u)
+        window_max(&l.row[std::size_t(b.v0 - v0) * std::size_t(wu) + std::size_t(u - u0)], wu, b.v0, bv, half, v0, wv,
+                   &l.top[std::size_t(u - u0)], wu, l.scratch);
+      // Every atom with a voxel the body over it would reach `a` from.
+      for (int v = v0; v <= v1; ++v)
+        for (int u = u0; u <= u1; ++u) {
+          const int t = l.top[std::size_t(v - v0) * std::size_t(wu) + std::size_t(u - u0)];
+          if (t == kNone) continue;
+          for (const Entry& e : in_column[std::size_t(v) * std::size_t(nu) + std::size_t(u)]) {
+            const int other = e.atom;
+            if (other == a || t < e.lowest + nozzle.standoff) continue;
+            AtomSet& s = l.reach[std::size_t(other)];
+            if (s.words().empty()) s = AtomSet(n);
+            s.set(a);
+          }
         }
+    }
+  });
+  for (const Local& l : locals)
+    for (std::size_t o = 0; o < l.reach.size(); ++o) {
+      const auto& from = l.reach[o].words();
+      if (from.empty()) continue;
+      AtomSet& into = reach[o];
+      if (into.words().empty()) {
+        into = l.reach[o];
+        continue;
       }
-  }
+      for (std::size_t w = 0; w < from.size(); ++w) into.words()[w] |= from[w];
+    }
   return reach;
 }
 
