@@ -3,6 +3,8 @@
 #include <array>
 #include <deque>
 
+#include <tbb/parallel_for.h>
+
 #include "geometry/shapes.hpp"
 #include "instruments/bead.hpp"
 #include "instruments/cutter.hpp"
@@ -111,6 +113,14 @@ std::vector<Primitive> machine_primitives(const config::Machine& m, const Solid&
     }
   }
 
+  // Deposits per head and setup, made in parallel (each cut to what builds layer by layer
+  // is one sequential pass over its layers), then numbered in order.
+  struct Deposit {
+    Primitive p;
+    const config::AdditiveHead* head;
+    const config::Setup* setup;
+  };
+  std::vector<Deposit> deposits;
   for (const auto& head : m.heads)
     for (const auto& setup : m.setups)
       for (const auto kind : head.primitives) {
@@ -119,22 +129,29 @@ std::vector<Primitive> machine_primitives(const config::Machine& m, const Solid&
         p.capability = head.name;
         p.setup = setup.name;
         p.cost_per_mm3 = head.cost_per_mm3;
-        const Instrument in = bead_instrument(head, setup.approach);
-        // Only what the head builds without support in this setup (planner/support.hpp).
-        const auto buildable = [&](const Solid& region) {
-          return self_supporting(region, instruments::approach_direction(setup.approach),
-                                 instruments::support_rule(head.support, design.voxel_size()), present);
-        };
         if (kind == config::PrimitiveKind::UAm) {
           p.kind = PrimitiveKind::UAm;
           p.label = "U-AM " + head.name + " " + setup_words(setup);
-          add(p, [&] { return buildable(additive_maximal(design, in)); });
         } else if (kind == config::PrimitiveKind::OAm) {
           p.kind = PrimitiveKind::OAm;
           p.label = "O-AM " + head.name + " " + setup_words(setup);
-          add(p, [&] { return buildable(additive_conservative(design, in)); });
+        } else {
+          continue;
         }
+        deposits.push_back({std::move(p), &head, &setup});
       }
+  if (progress && !deposits.empty()) progress(out.size(), total, deposits.front().p.label);
+  std::vector<Solid> deposited(deposits.size());
+  tbb::parallel_for(std::size_t(0), deposits.size(), [&](std::size_t k) {
+    const Deposit& d = deposits[k];
+    const Instrument in = bead_instrument(*d.head, d.setup->approach);
+    const Solid region = d.p.kind == PrimitiveKind::UAm ? additive_maximal(design, in) : additive_conservative(design, in);
+    // Only what the head builds without support in this setup (planner/support.hpp).
+    deposited[k] = self_supporting(region, instruments::approach_direction(d.setup->approach),
+                                   instruments::support_rule(d.head->support, design.voxel_size()), present);
+  });
+  for (std::size_t k = 0; k < deposits.size(); ++k)
+    add(std::move(deposits[k].p), [&] { return std::move(deposited[k]); });
 
   // Removal regions are computed together: tools from the same side share the design's
   // distance transforms (primitive_shapes.hpp, removal_regions).
