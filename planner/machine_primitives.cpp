@@ -76,6 +76,57 @@ geometry::Box3 stock_bounds(const config::RawStock& s, const geometry::Box3& d) 
   return {{c.x - half.x, c.y - half.y, c.z - half.z}, {c.x + half.x, c.y + half.y, c.z + half.z}};
 }
 
+namespace {
+
+// The deposits per head and setup (U-AM, O-AM), unnamed, made in parallel: each one's cut
+// to what builds layer by layer (planner/support.hpp) is one sequential pass over its layers.
+std::vector<Primitive> deposit_primitives(const config::Machine& m, const Solid& design, const Solid* present) {
+  struct Deposit {
+    Primitive p;
+    const config::AdditiveHead* head;
+    const config::Setup* setup;
+  };
+  std::vector<Deposit> deposits;
+  for (const auto& head : m.heads)
+    for (const auto& setup : m.setups)
+      for (const auto kind : head.primitives) {
+        Primitive p;
+        p.mode = Mode::Additive;
+        p.capability = head.name;
+        p.setup = setup.name;
+        p.cost_per_mm3 = head.cost_per_mm3;
+        if (kind == config::PrimitiveKind::UAm) {
+          p.kind = PrimitiveKind::UAm;
+          p.label = "U-AM " + head.name + " " + setup_words(setup);
+        } else if (kind == config::PrimitiveKind::OAm) {
+          p.kind = PrimitiveKind::OAm;
+          p.label = "O-AM " + head.name + " " + setup_words(setup);
+        } else {
+          continue;
+        }
+        deposits.push_back({std::move(p), &head, &setup});
+      }
+  tbb::parallel_for(std::size_t(0), deposits.size(), [&](std::size_t k) {
+    Deposit& d = deposits[k];
+    const Instrument in = bead_instrument(*d.head, d.setup->approach);
+    const Solid region = d.p.kind == PrimitiveKind::UAm ? additive_maximal(design, in) : additive_conservative(design, in);
+    // Only what the head builds without support in this setup.
+    d.p.region = self_supporting(region, instruments::approach_direction(d.setup->approach),
+                                 instruments::support_rule(d.head->support, design.voxel_size()), present);
+  });
+  std::vector<Primitive> out;
+  for (Deposit& d : deposits) out.push_back(std::move(d.p));
+  return out;
+}
+
+bool machine_has_deposits(const config::Machine& m) {
+  for (const auto& head : m.heads)
+    if (!head.primitives.empty() && !m.setups.empty()) return true;
+  return false;
+}
+
+}  // namespace
+
 std::vector<Primitive> machine_primitives(const config::Machine& m, const Solid& design,
                                           const geometry::IndexBox& domain, const PrimitiveProgress& progress,
                                           const Solid* present) {
@@ -113,45 +164,11 @@ std::vector<Primitive> machine_primitives(const config::Machine& m, const Solid&
     }
   }
 
-  // Deposits per head and setup, made in parallel (each cut to what builds layer by layer
-  // is one sequential pass over its layers), then numbered in order.
-  struct Deposit {
-    Primitive p;
-    const config::AdditiveHead* head;
-    const config::Setup* setup;
-  };
-  std::vector<Deposit> deposits;
-  for (const auto& head : m.heads)
-    for (const auto& setup : m.setups)
-      for (const auto kind : head.primitives) {
-        Primitive p;
-        p.mode = Mode::Additive;
-        p.capability = head.name;
-        p.setup = setup.name;
-        p.cost_per_mm3 = head.cost_per_mm3;
-        if (kind == config::PrimitiveKind::UAm) {
-          p.kind = PrimitiveKind::UAm;
-          p.label = "U-AM " + head.name + " " + setup_words(setup);
-        } else if (kind == config::PrimitiveKind::OAm) {
-          p.kind = PrimitiveKind::OAm;
-          p.label = "O-AM " + head.name + " " + setup_words(setup);
-        } else {
-          continue;
-        }
-        deposits.push_back({std::move(p), &head, &setup});
-      }
-  if (progress && !deposits.empty()) progress(out.size(), total, deposits.front().p.label);
-  std::vector<Solid> deposited(deposits.size());
-  tbb::parallel_for(std::size_t(0), deposits.size(), [&](std::size_t k) {
-    const Deposit& d = deposits[k];
-    const Instrument in = bead_instrument(*d.head, d.setup->approach);
-    const Solid region = d.p.kind == PrimitiveKind::UAm ? additive_maximal(design, in) : additive_conservative(design, in);
-    // Only what the head builds without support in this setup (planner/support.hpp).
-    deposited[k] = self_supporting(region, instruments::approach_direction(d.setup->approach),
-                                   instruments::support_rule(d.head->support, design.voxel_size()), present);
-  });
-  for (std::size_t k = 0; k < deposits.size(); ++k)
-    add(std::move(deposits[k].p), [&] { return std::move(deposited[k]); });
+  if (progress && machine_has_deposits(m)) progress(out.size(), total, "deposits");
+  for (Primitive& p : deposit_primitives(m, design, present)) {
+    Solid region = std::move(p.region);
+    add(std::move(p), [&] { return std::move(region); });
+  }
 
   // Removal regions are computed together: tools from the same side share the design's
   // distance transforms (primitive_shapes.hpp, removal_regions).
