@@ -117,6 +117,14 @@ void LowerBound::index_lists() {
     setup_mask_.push_back(mask([&](int i) { return setup_id_[std::size_t(i)] == int(t); }));
 }
 
+std::vector<double> LowerBound::per_primitive(const std::vector<double>& per_list) const {
+  std::vector<double> out(p_.primitives.size(), 0);
+  for (std::size_t l = 0; l < lists_.size(); ++l)
+    if (per_list[l] != 0)
+      for (int i : lists_[l]) out[std::size_t(i)] += per_list[l];
+  return out;
+}
+
 std::vector<char> LowerBound::needed_lists(const AtomSet& state) const {
   std::vector<char> needed(lists_.size(), 0);
   const auto& s = state.words();
@@ -174,10 +182,7 @@ double LowerBound::removals_with_design_cut(const AtomSet& state, const Rates& r
       const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
       per_list[std::size_t(remover_list_[a])] += r.deposit(a) * p_.atoms[a].volume;
     }
-  std::vector<double> cut_share(p_.primitives.size(), 0);
-  for (std::size_t l = 0; l < lists_.size(); ++l)
-    if (per_list[l] != 0)
-      for (int i : lists_[l]) cut_share[std::size_t(i)] += per_list[l];
+  const std::vector<double> cut_share = per_primitive(per_list);
   std::vector<std::pair<double, int>> shares;
   for (std::size_t i = 0; i < p_.primitives.size(); ++i) {
     const PrimitiveSpec& prim = p_.primitives[i];
@@ -270,10 +275,7 @@ LowerBound::SideShares LowerBound::side_effects(const AtomSet& state, const Rate
       per_list[l] += atom.volume * (rate[l] + (atom.must_in ? rate[std::size_t(adder_list_[a])] : 0));
     }
   }
-  std::vector<double> side(p_.primitives.size(), 0);
-  for (std::size_t l = 0; l < lists_.size(); ++l)
-    if (per_list[l] != 0)
-      for (int i : lists_[l]) side[std::size_t(i)] += per_list[l];
+  const std::vector<double> side = per_primitive(per_list);
   const std::vector<char> needed = needed_lists(state);
   // Per list, the volume of its atoms that are wrong: the first of its suppliers a
   // completion uses changes all of them (no other primitive holds them), at its own rate.

@@ -82,6 +82,9 @@ class LowerBound {
   std::vector<std::vector<std::uint64_t>> list_mask_, tool_mask_, setup_mask_;
   // Per list with a wrong atom in `state` (must-in missing: adders; must-out present: removers).
   std::vector<char> needed_lists(const AtomSet& state) const;
+  // Per primitive, the sum over the supplier lists it is on (an atom is held by exactly the
+  // primitives of its lists, so a sum over atoms per primitive is one per list, added up).
+  std::vector<double> per_primitive(const std::vector<double>& per_list) const;
   std::vector<int> tool_id_, setup_id_;               // per primitive
   std::vector<double> setup_entry_;                   // per setup id: the least a change into it costs
   std::vector<bool> dirty_;  // an additive primitive holding a must-out atom
