@@ -137,7 +137,9 @@ std::vector<std::pair<int, std::string>> atoms_no_deposit_makes(const PlanningPr
 
 // An atom that rules the part out, located, with the primitives holding it and what the
 // tolerance zone says of it; the caller writes its description.
-ViolatingAtom offending_atom(const PlanningProblem& p, const AtomMeasures& m, int a, const Lattice& lattice) {
+}  // namespace
+
+ViolatingAtom located_atom(const PlanningProblem& p, const AtomMeasures& m, int a, const Lattice& lattice) {
   ViolatingAtom va;
   va.atom = a;
   va.code = m.code.bits(int(p.primitives.size()));
@@ -154,7 +156,37 @@ ViolatingAtom offending_atom(const PlanningProblem& p, const AtomMeasures& m, in
   return va;
 }
 
-}  // namespace
+Verdict core_verdict(const PlanningProblem& p, const CoreProof& proof, const std::vector<AtomMeasures>& measures,
+                     const Lattice& lattice) {
+  Verdict v;
+  v.manufacturable = false;
+  v.decided_without_search = true;
+  int design = 0;
+  for (const int a : proof.core) {
+    const AtomMeasures& m = measures[std::size_t(a)];
+    ViolatingAtom va = located_atom(p, m, a, lattice);
+    const bool in = p.atoms[std::size_t(a)].must_in, out = p.atoms[std::size_t(a)].must_out;
+    design += in;
+    std::string names;
+    for (std::size_t k = 0; k < va.primitives.size() && k < 4; ++k)
+      names += (k ? ", " : "") + p.primitives[std::size_t(va.primitives[k])].name;
+    if (va.primitives.size() > 4) names += " and " + std::to_string(va.primitives.size() - 4) + " more";
+    va.description = "a " + format("%.3g", m.volume) + " mm\u00B3 region " +
+                     (in ? "of the design" : out ? "outside the design" : "in the tolerance band") + " around " +
+                     format("(%.1f, %.1f, %.1f)", m.centroid.x, m.centroid.y, m.centroid.z) + " mm" +
+                     (in ? " (must be made)" : out ? " (must be left empty)" : " (carries or blocks the others)") +
+                     (names.empty() ? ", in no primitive" : ", in " + names);
+    v.violations.push_back(std::move(va));
+  }
+  std::sort(v.violations.begin(), v.violations.end(),
+            [](const ViolatingAtom& x, const ViolatingAtom& y) { return x.volume > y.volume; });
+  v.summary = "no sequence of the " + std::to_string(p.primitives.size()) +
+              " primitives gets these " + std::to_string(proof.core.size()) + " atoms right together (" +
+              std::to_string(design) + " of the design), whatever the other atoms do: deposits cannot reach under "
+              "material already there or lay a first layer on nothing, and removals cut what they hold (proven over " +
+              std::to_string(proof.states) + " states of " + std::to_string(proof.rounds) + " projections)";
+  return v;
+}
 
 Verdict check_manufacturability(const PlanningProblem& p, const std::vector<AtomMeasures>& measures,
                                 const Lattice& lattice) {
@@ -175,7 +207,7 @@ Verdict check_manufacturability(const PlanningProblem& p, const std::vector<Atom
   for (int a = 0; a < int(measures.size()); ++a) {
     const AtomMeasures& m = measures[std::size_t(a)];
     if (m.atom_class != AtomClass::Violating) continue;
-    ViolatingAtom va = offending_atom(p, m, a, lattice);
+    ViolatingAtom va = located_atom(p, m, a, lattice);
     va.description = describe(p, va);
     v.violations.push_back(std::move(va));
   }
@@ -204,7 +236,7 @@ Verdict check_manufacturability(const PlanningProblem& p, const std::vector<Atom
     case Modality::Hybrid:
       for (const auto& [a, why] : atoms_no_deposit_makes(p, measures)) {
         const AtomMeasures& m = measures[std::size_t(a)];
-        ViolatingAtom va = offending_atom(p, m, a, lattice);
+        ViolatingAtom va = located_atom(p, m, a, lattice);
         va.description = "a " + format("%.3g", m.volume) + " mm\u00B3 region of the design around " +
                          format("(%.1f, %.1f, %.1f)", m.centroid.x, m.centroid.y, m.centroid.z) + " mm: " + why;
         v.violations.push_back(std::move(va));

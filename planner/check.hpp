@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "planner/atoms.hpp"
+#include "planner/core_proof.hpp"
 #include "planner/search.hpp"
 
 namespace hybridctl::planner {
@@ -39,6 +40,15 @@ struct Verdict {
   std::string summary;
   std::vector<ViolatingAtom> violations;
 };
+
+// An atom located (bounds, centroid), with the primitives holding it and what the tolerance
+// zone says of it; its description is the caller's.
+ViolatingAtom located_atom(const PlanningProblem& problem, const AtomMeasures& measures, int atom, const Lattice& lattice);
+
+// The verdict of a proof that no plan exists (planner/core_proof.hpp): the atoms it needs,
+// each located with the primitives that hold it.
+Verdict core_verdict(const PlanningProblem& problem, const CoreProof& proof, const std::vector<AtomMeasures>& measures,
+                     const Lattice& lattice);
 
 // `problem` carries the primitives' names, modes and atom sets; `measures` the atoms.
 Verdict check_manufacturability(const PlanningProblem& problem, const std::vector<AtomMeasures>& measures,

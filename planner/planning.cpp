@@ -513,6 +513,13 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
       if (u.atom == v.atom) v.description += "; " + u.why;
   clock.lap("check");
   double validation_seconds = 0;
+  if (r.verdict.manufacturable && r.verdict.modality == Modality::Hybrid) {
+    // Cheap where it works (the B-axis overhang: milliseconds) and bounded where it does
+    // not; the search cannot prove a hybrid problem infeasible short of exhausting it.
+    r.core_proof = prove_by_core(r.problem);
+    if (r.core_proof.outcome == CoreProof::Outcome::Proven) r.verdict = core_verdict(r.problem, r.core_proof, r.measures, r.lattice);
+    clock.lap("proof");
+  }
   if (r.verdict.manufacturable) search_plans(top_k, options, progress, r, validation_seconds);
   clock.lap("search");
   if (r.validated) {

@@ -10,6 +10,7 @@
 #include "config/machine.hpp"
 #include "geometry/mesh.hpp"
 #include "planner/atoms.hpp"
+#include "planner/core_proof.hpp"
 #include "planner/fine_graining.hpp"
 #include "planner/check.hpp"
 #include "planner/costing.hpp"
@@ -113,6 +114,9 @@ struct PlanningResult {
   bool validated = false;              // the plans were validated (PlanningOptions::validate)
   SearchStats search;
   FineGraining fine_graining;  // what fine-graining added, and what it could not split
+  // The proof from a few atoms tried before the search (planner/core_proof.hpp); Proven
+  // decides the verdict.
+  CoreProof core_proof;
   // What the plans' costs are in (minutes, money or cost factors), and each plan's
   // estimate in minutes and money whatever the objective, with the machine's currency.
   config::Objective objective = config::Objective::CostFactor;

@@ -236,16 +236,20 @@ TEST_F(Cli, AWornHubIsRepairedByDepositingOnlyWhatItLacksAndEveryPlanRunsWithinT
 
 // The bracket's horizontal hole has a roof that no deposit from +Z holds up (it overhangs
 // far past the head's 30 degrees) and that a deposit from -Z, turned over, could only lay
-// under the material already there. The planner proves that no order of its primitives
-// makes the part and names the roof, without offering validation a plan that must fail.
+// under the material already there. The planner proves, before any search, that no order
+// of its primitives makes the roof, the hole and what carries them right together, and
+// names the roof, without offering validation a plan that must fail.
 TEST_F(Cli, TheBracketIsProvenNotManufacturableOnTheThreeAxisMachineAndTheHoleRoofIsNamed) {
   const Outcome r = run({"plan", kBracket, "--machine", kMachine, "--voxel", "1"});
   EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
-  EXPECT_NE(r.out.find("verdict     NOT manufacturable: no sequence of these primitives makes the design"), std::string::npos)
+  EXPECT_NE(r.out.find("verdict     NOT manufacturable: no sequence of the 18 primitives gets these"), std::string::npos)
       << r.out;
-  EXPECT_NE(r.out.find("0 candidates rejected"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("rejected"), std::string::npos) << r.out;
   // The roof of the 10 mm hole through the wall (x 0..10, y 20, z 35): its top is at z 40.
-  EXPECT_NE(r.out.find("around (5.0, 20.0, 40."), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("region of the design around (5.0, 20.0, 40."), std::string::npos) << r.out;
+  // ... and the hole itself.
+  EXPECT_NE(r.out.find("region outside the design around (5.0, 20.0, 35.0) mm (must be left empty)"), std::string::npos)
+      << r.out;
 }
 
 TEST_F(Cli, PlanRefusesToReplaceADirectoryThatIsNotAPlan) {

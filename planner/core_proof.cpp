@@ -1,0 +1,344 @@
+// A proof that no plan exists, from a few atoms (core_proof.hpp).
+
+#include "planner/core_proof.hpp"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <deque>
+#include <unordered_map>
+
+#include "planner/search_steps.hpp"
+
+namespace hybridctl::planner {
+namespace {
+
+// A set of atoms of S, bit k for S's k-th atom, in W words (the fewest that hold S: the
+// projected search's time goes into these).
+template <int W>
+struct Mask {
+  static constexpr int kWords = W;
+  std::array<std::uint64_t, kWords> w{};
+  void set(std::size_t k) { w[k / 64] |= std::uint64_t{1} << (k % 64); }
+  bool test(std::size_t k) const { return (w[k / 64] >> (k % 64)) & 1u; }
+  bool any() const {
+    for (const std::uint64_t x : w)
+      if (x) return true;
+    return false;
+  }
+  int count() const {
+    int n = 0;
+    for (const std::uint64_t x : w) n += std::popcount(x);
+    return n;
+  }
+  friend Mask operator&(Mask a, const Mask& b) {
+    for (int i = 0; i < kWords; ++i) a.w[std::size_t(i)] &= b.w[std::size_t(i)];
+    return a;
+  }
+  friend Mask operator|(Mask a, const Mask& b) {
+    for (int i = 0; i < kWords; ++i) a.w[std::size_t(i)] |= b.w[std::size_t(i)];
+    return a;
+  }
+  friend Mask operator~(Mask a) {
+    for (std::uint64_t& x : a.w) x = ~x;
+    return a;
+  }
+  friend bool operator==(const Mask&, const Mask&) = default;
+  // Calls f(k) for each member k.
+  template <typename F>
+  void each(F f) const {
+    for (std::size_t i = 0; i < w.size(); ++i)
+      for (std::uint64_t b = w[i]; b; b &= b - 1) f(i * 64 + std::size_t(std::countr_zero(b)));
+  }
+};
+
+struct MaskHash {
+  template <int W>
+  std::size_t operator()(const Mask<W>& m) const {
+    std::uint64_t h = 0x9E3779B97F4A7C15ull;
+    for (const std::uint64_t x : m.w) h = (h ^ x) * 0xBF58476D1CE4E5B9ull, h ^= h >> 31;
+    return std::size_t(h);
+  }
+};
+
+// The members of `set` among the atoms of S, as bits of S's order.
+template <int W>
+Mask<W> bits_in(const AtomSet& set, const std::vector<int>& s) {
+  Mask<W> m;
+  if (set.words().empty()) return m;
+  for (std::size_t k = 0; k < s.size(); ++k)
+    if (set.test(s[k])) m.set(k);
+  return m;
+}
+
+int members(const AtomSet& set) {
+  int n = 0;
+  for (const std::uint64_t w : set.words()) n += std::popcount(w);
+  return n;
+}
+
+// A primitive as the projection on S sees it.
+template <int W>
+struct ProjectedPrimitive {
+  using Mask = hybridctl::planner::Mask<W>;
+  int index = 0;       // in the problem
+  bool additive = false;
+  bool first = false;  // may start a plan
+  bool later = false;  // may come later
+  Mask all;            // its atoms in S
+  Mask begun;          // ... less those it falls short of once the plan has begun
+  Mask needs_carrier;             // atoms whose every possible carrier is in S
+  std::vector<Mask> blockers;     // per atom of S: the atoms of S that block the head from it
+  std::vector<Mask> carriers;     // per atom in needs_carrier: its carriers
+
+  bool same(const ProjectedPrimitive& o) const {
+    return additive == o.additive && first == o.first && later == o.later && all == o.all && begun == o.begun &&
+           needs_carrier == o.needs_carrier && blockers == o.blockers && carriers == o.carriers;
+  }
+};
+
+template <int W>
+struct Projection {
+  using Mask = hybridctl::planner::Mask<W>;
+  // One of each: primitives that act alike on S are one to the projected search.
+  std::vector<ProjectedPrimitive<W>> primitives;
+  Mask must_in, must_out;
+  // Must-out atoms no removal holds: a state with one of them leads nowhere.
+  Mask stuck;
+};
+
+template <int W>
+Projection<W> project(const PlanningProblem& p, const std::vector<int>& s) {
+  using Mask = hybridctl::planner::Mask<W>;
+  Projection<W> pr;
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    if (p.atoms[std::size_t(s[k])].must_in) pr.must_in.set(k);
+    if (p.atoms[std::size_t(s[k])].must_out) pr.must_out.set(k);
+  }
+  const std::vector<std::uint8_t> no_uses(p.primitives.size(), 0);
+  for (std::size_t i = 0; i < p.primitives.size(); ++i) {
+    const PrimitiveSpec& prim = p.primitives[i];
+    ProjectedPrimitive<W> q;
+    q.index = int(i);
+    q.additive = prim.mode == Mode::Additive;
+    q.first = detail::allowed(p, int(i), true, no_uses) && members(prim.atoms) > 0;  // a step changes something
+    q.later = detail::allowed(p, int(i), false, no_uses);
+    q.all = bits_in<W>(prim.atoms, s);
+    q.begun = q.all & ~bits_in<W>(prim.falls_short, s);
+    q.blockers.assign(s.size(), Mask{});
+    q.carriers.assign(s.size(), Mask{});
+    for (std::size_t k = 0; k < s.size() && q.additive; ++k) {
+      if (!q.all.test(k)) continue;
+      if (prim.blocked_by) q.blockers[k] = bits_in<W>((*prim.blocked_by)[std::size_t(s[k])], s);
+      if (!prim.footing || prim.footing->kind[std::size_t(s[k])] != DepositFooting::NeedsCarrier) continue;
+      // A carrier outside S is taken as present: only carriers all in S can be missing.
+      const AtomSet& carriers = prim.footing->carriers[std::size_t(s[k])];
+      const Mask in_s = bits_in<W>(carriers, s);
+      if (in_s.count() == members(carriers)) q.needs_carrier.set(k), q.carriers[k] = in_s;
+    }
+    if (std::none_of(pr.primitives.begin(), pr.primitives.end(), [&](const ProjectedPrimitive<W>& o) { return o.same(q); }))
+      pr.primitives.push_back(std::move(q));
+  }
+  Mask removable;
+  for (const ProjectedPrimitive<W>& q : pr.primitives)
+    if (!q.additive && q.later) removable = removable | q.begun;
+  pr.stuck = pr.must_out & ~removable;
+  return pr;
+}
+
+// The projected state after primitive q, or false when it changes nothing in S or may not
+// be taken there.
+template <int W>
+bool step(const ProjectedPrimitive<W>& q, const Mask<W>& state, bool first, Mask<W>& next) {
+  using Mask = hybridctl::planner::Mask<W>;
+  const Mask& does = first ? q.all : q.begun;
+  if (!q.additive) {
+    const Mask changed = does & state;
+    next = state & ~changed;
+    return changed.any();
+  }
+  const Mask changed = does & ~state;
+  if (!changed.any() && !first) return false;
+  bool refused = false;
+  changed.each([&](std::size_t k) {
+    refused = refused || (q.blockers[k] & state).any() ||
+              (!first && q.needs_carrier.test(k) && !(q.carriers[k] & state).any());
+  });
+  if (refused) return false;
+  next = state | changed;
+  return true;
+}
+
+enum class Search { NoPlan, Plan, Limit };
+
+// Breadth first over the projected states; on Plan, `sequence` reaches the projected goal.
+// `states` counts the states reached, and the search stops when it passes `max_states`.
+template <int W>
+Search search_projection(const Projection<W>& pr, std::int64_t max_states, std::int64_t& states, std::vector<int>& sequence) {
+  using Mask = hybridctl::planner::Mask<W>;
+  struct Node {
+    Mask state;
+    int parent;  // -1: the plan's first action made it
+    int primitive;
+  };
+  std::vector<Node> nodes;
+  std::unordered_map<Mask, int, MaskHash> seen;  // begun states; the start (nothing, not begun) is apart
+  std::deque<int> queue;
+  const auto goal = [&](const Mask& m) { return (m & pr.must_in) == pr.must_in && !(m & pr.must_out).any(); };
+  // Every successor of a node (-1: the start), until the goal or the limit.
+  const auto expand = [&](int at) {
+    const bool first = at < 0;
+    const Mask state = first ? Mask{} : nodes[std::size_t(at)].state;
+    for (std::size_t i = 0; i < pr.primitives.size(); ++i) {
+      const ProjectedPrimitive<W>& q = pr.primitives[i];
+      Mask next;
+      if (!(first ? q.first : q.later) || !step(q, state, first, next) || (next & pr.stuck).any() || seen.count(next))
+        continue;
+      if (++states > max_states) return Search::Limit;
+      seen.emplace(next, int(nodes.size()));
+      nodes.push_back({next, at, q.index});
+      if (goal(next)) {
+        sequence.clear();
+        for (int n = int(nodes.size()) - 1; n >= 0; n = nodes[std::size_t(n)].parent)
+          sequence.push_back(nodes[std::size_t(n)].primitive);
+        std::reverse(sequence.begin(), sequence.end());
+        return Search::Plan;
+      }
+      queue.push_back(int(nodes.size()) - 1);
+    }
+    return Search::NoPlan;
+  };
+  for (int at = -1;; at = queue.front(), queue.pop_front()) {
+    if (const Search s = expand(at); s != Search::NoPlan) return s;
+    if (queue.empty()) return Search::NoPlan;
+  }
+}
+
+// Where a projected plan goes wrong in the whole problem: the atoms outside S that show it
+// (empty with `goal` when it makes the part, empty without when nothing explains it).
+struct Replay {
+  bool goal = false;
+  bool too_many_uses = false;  // a primitive used more than max_uses times (before the goal)
+  std::size_t steps = 0;  // on goal: the steps taken when it was first reached
+  std::vector<int> atoms;
+};
+
+// The atoms that keep a deposit from being taken in `state`: one atom out of reach and
+// what blocks it, or else the atom of a first layer with the fewest that could carry it,
+// and those (a few only: S stays small).
+std::vector<int> why_refused(const PlanningProblem& p, const PrimitiveSpec& prim, const AtomSet& state, bool first) {
+  constexpr int kMostCarriers = 256;
+  const auto& s = state.words();
+  const auto& a = prim.atoms.words();
+  const auto& short_of = prim.falls_short.words();
+  int floating = -1, fewest = kMostCarriers + 1;
+  for (std::size_t w = 0; w < a.size(); ++w) {
+    const std::uint64_t does = !first && w < short_of.size() ? a[w] & ~short_of[w] : a[w];
+    for (std::uint64_t b = does & ~s[w]; b; b &= b - 1) {
+      const int atom = int(w * 64) + std::countr_zero(b);
+      if (prim.blocked_by && prim.blocked_by->meets(std::size_t(atom), s)) {
+        const auto& blockers = (*prim.blocked_by)[std::size_t(atom)].words();
+        for (std::size_t v = 0; v < blockers.size(); ++v)
+          if (const std::uint64_t hit = blockers[v] & s[v]) return {atom, int(v * 64) + std::countr_zero(hit)};
+      }
+      if (first || !prim.footing || prim.footing->kind[std::size_t(atom)] != DepositFooting::NeedsCarrier ||
+          prim.footing->carriers.meets(std::size_t(atom), s))
+        continue;
+      const int n = members(prim.footing->carriers[std::size_t(atom)]);
+      if (n < fewest) fewest = n, floating = atom;
+    }
+  }
+  if (floating < 0) return {};
+  std::vector<int> why{floating};
+  const AtomSet& carriers = prim.footing->carriers[std::size_t(floating)];
+  for (int c = 0; c < int(p.atoms.size()) && !carriers.words().empty(); ++c)
+    if (carriers.test(c)) why.push_back(c);
+  return why;
+}
+
+Replay replay(const PlanningProblem& p, const std::vector<int>& sequence, const std::vector<int>& fixers,
+              int atoms_per_round) {
+  Replay r;
+  AtomSet state(int(p.atoms.size()));
+  bool first = true;
+  std::vector<int> uses(p.primitives.size(), 0);
+  for (const int i : sequence) {
+    // The projection allows any number of uses: a plan that needs more is no plan, but
+    // where it goes wrong otherwise still names atoms.
+    r.too_many_uses = r.too_many_uses || ++uses[std::size_t(i)] > p.max_uses;
+    AtomSet next;
+    double volume = 0;
+    if (!detail::apply(p, state, i, next, volume, first)) {
+      r.atoms = why_refused(p, p.primitives[std::size_t(i)], state, first);
+      return r;
+    }
+    state = std::move(next);
+    first = false;
+    ++r.steps;
+    if (is_goal(p, state)) return r.goal = true, r;
+  }
+  // Atoms wrong at the end: the most constrained first (fewest primitives that could put
+  // them right), then the largest.
+  std::vector<int> wrong;
+  for (int a = 0; a < int(p.atoms.size()); ++a) {
+    const AtomSpec& spec = p.atoms[std::size_t(a)];
+    if (spec.must_in != state.test(a) && (spec.must_in || spec.must_out)) wrong.push_back(a);
+  }
+  std::sort(wrong.begin(), wrong.end(), [&](int x, int y) {
+    if (fixers[std::size_t(x)] != fixers[std::size_t(y)]) return fixers[std::size_t(x)] < fixers[std::size_t(y)];
+    return p.atoms[std::size_t(x)].volume > p.atoms[std::size_t(y)].volume;
+  });
+  wrong.resize(std::min(wrong.size(), std::size_t(atoms_per_round)));
+  r.atoms = std::move(wrong);
+  return r;
+}
+
+// Per atom, how many primitives could put it right: deposits holding a must-in atom,
+// removals holding a must-out one.
+std::vector<int> count_fixers(const PlanningProblem& p) {
+  std::vector<int> fixers(p.atoms.size(), 0);
+  for (const PrimitiveSpec& prim : p.primitives)
+    for (std::size_t a = 0; a < p.atoms.size(); ++a)
+      if (prim.atoms.test(int(a)) && (prim.mode == Mode::Additive ? p.atoms[a].must_in : p.atoms[a].must_out))
+        ++fixers[a];
+  return fixers;
+}
+
+}  // namespace
+
+CoreProof prove_by_core(const PlanningProblem& p, const CoreProofLimits& limits) {
+  CoreProof proof;
+  const std::vector<int> fixers = count_fixers(p);
+  std::vector<int> s;
+  std::vector<char> in_s(p.atoms.size(), 0);
+  for (;;) {
+    ++proof.rounds;
+    std::vector<int> sequence;
+    const Search found = s.size() <= 64    ? search_projection(project<1>(p, s), limits.max_states, proof.states, sequence)
+                         : s.size() <= 128 ? search_projection(project<2>(p, s), limits.max_states, proof.states, sequence)
+                         : s.size() <= 256 ? search_projection(project<4>(p, s), limits.max_states, proof.states, sequence)
+                                           : search_projection(project<8>(p, s), limits.max_states, proof.states, sequence);
+    if (found == Search::Limit) return proof;
+    if (found == Search::NoPlan) {
+      proof.outcome = CoreProof::Outcome::Proven;
+      proof.core = s;
+      std::sort(proof.core.begin(), proof.core.end());
+      return proof;
+    }
+    Replay r = replay(p, sequence, fixers, limits.atoms_per_round);
+    if (r.goal && r.too_many_uses) return proof;
+    if (r.goal) {
+      proof.outcome = CoreProof::Outcome::Feasible;
+      sequence.resize(r.steps);
+      proof.sequence = std::move(sequence);
+      return proof;
+    }
+    std::sort(r.atoms.begin(), r.atoms.end());  // an atom may carry itself: once in S
+    r.atoms.erase(std::unique(r.atoms.begin(), r.atoms.end()), r.atoms.end());
+    std::erase_if(r.atoms, [&](int a) { return in_s[std::size_t(a)] != 0; });
+    if (r.atoms.empty() || int(s.size() + r.atoms.size()) > limits.max_atoms) return proof;
+    for (const int a : r.atoms) s.push_back(a), in_s[std::size_t(a)] = 1;
+  }
+}
+
+}  // namespace hybridctl::planner
