@@ -5,8 +5,6 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <deque>
-#include <unordered_map>
 
 #include "planner/search_steps.hpp"
 
@@ -87,13 +85,19 @@ struct ProjectedPrimitive {
   bool later = false;  // may come later
   Mask all;            // its atoms in S
   Mask begun;          // ... less those it falls short of once the plan has begun
-  Mask needs_carrier;             // atoms whose every possible carrier is in S
-  std::vector<Mask> blockers;     // per atom of S: the atoms of S that block the head from it
-  std::vector<Mask> carriers;     // per atom in needs_carrier: its carriers
+  // Per atom of S that something in S blocks the head from: what does. Per atom whose
+  // every possible carrier is in S: those. Only these atoms are asked when deposited.
+  struct Condition {
+    std::size_t atom;
+    Mask set;
+    friend bool operator==(const Condition&, const Condition&) = default;
+  };
+  Mask blocked, carried;
+  std::vector<Condition> blockers, carriers;
 
   bool same(const ProjectedPrimitive& o) const {
     return additive == o.additive && first == o.first && later == o.later && all == o.all && begun == o.begun &&
-           needs_carrier == o.needs_carrier && blockers == o.blockers && carriers == o.carriers;
+           blockers == o.blockers && carriers == o.carriers;
   }
 };
 
@@ -103,8 +107,6 @@ struct Projection {
   // One of each: primitives that act alike on S are one to the projected search.
   std::vector<ProjectedPrimitive<W>> primitives;
   Mask must_in, must_out;
-  // Must-out atoms no removal holds: a state with one of them leads nowhere.
-  Mask stuck;
 };
 
 template <int W>
@@ -125,24 +127,19 @@ Projection<W> project(const PlanningProblem& p, const std::vector<int>& s) {
     q.later = detail::allowed(p, int(i), false, no_uses);
     q.all = bits_in<W>(prim.atoms, s);
     q.begun = q.all & ~bits_in<W>(prim.falls_short, s);
-    q.blockers.assign(s.size(), Mask{});
-    q.carriers.assign(s.size(), Mask{});
     for (std::size_t k = 0; k < s.size() && q.additive; ++k) {
       if (!q.all.test(k)) continue;
-      if (prim.blocked_by) q.blockers[k] = bits_in<W>((*prim.blocked_by)[std::size_t(s[k])], s);
+      if (const Mask over = prim.blocked_by ? bits_in<W>((*prim.blocked_by)[std::size_t(s[k])], s) : Mask{}; over.any())
+        q.blocked.set(k), q.blockers.push_back({k, over});
       if (!prim.footing || prim.footing->kind[std::size_t(s[k])] != DepositFooting::NeedsCarrier) continue;
       // A carrier outside S is taken as present: only carriers all in S can be missing.
       const AtomSet& carriers = prim.footing->carriers[std::size_t(s[k])];
       const Mask in_s = bits_in<W>(carriers, s);
-      if (in_s.count() == members(carriers)) q.needs_carrier.set(k), q.carriers[k] = in_s;
+      if (in_s.count() == members(carriers)) q.carried.set(k), q.carriers.push_back({k, in_s});
     }
     if (std::none_of(pr.primitives.begin(), pr.primitives.end(), [&](const ProjectedPrimitive<W>& o) { return o.same(q); }))
       pr.primitives.push_back(std::move(q));
   }
-  Mask removable;
-  for (const ProjectedPrimitive<W>& q : pr.primitives)
-    if (!q.additive && q.later) removable = removable | q.begun;
-  pr.stuck = pr.must_out & ~removable;
   return pr;
 }
 
@@ -159,12 +156,12 @@ bool step(const ProjectedPrimitive<W>& q, const Mask<W>& state, bool first, Mask
   }
   const Mask changed = does & ~state;
   if (!changed.any() && !first) return false;
-  bool refused = false;
-  changed.each([&](std::size_t k) {
-    refused = refused || (q.blockers[k] & state).any() ||
-              (!first && q.needs_carrier.test(k) && !(q.carriers[k] & state).any());
-  });
-  if (refused) return false;
+  if ((changed & q.blocked).any())
+    for (const auto& c : q.blockers)
+      if (changed.test(c.atom) && (c.set & state).any()) return false;
+  if (!first && (changed & q.carried).any())
+    for (const auto& c : q.carriers)
+      if (changed.test(c.atom) && !(c.set & state).any()) return false;
   next = state | changed;
   return true;
 }
@@ -181,22 +178,34 @@ Search search_projection(const Projection<W>& pr, std::int64_t max_states, std::
     int parent;  // -1: the plan's first action made it
     int primitive;
   };
-  std::vector<Node> nodes;
-  std::unordered_map<Mask, int, MaskHash> seen;  // begun states; the start (nothing, not begun) is apart
-  std::deque<int> queue;
+  std::vector<Node> nodes;  // in the order reached: breadth first, they are the queue
+  // Begun states, as indices into `nodes` plus one (0: empty), open addressing; the start
+  // (nothing, not begun) is apart.
+  std::vector<std::uint32_t> slots(std::size_t(1) << 12, 0);
+  const auto slot_of = [&](const Mask& m) {
+    std::size_t h = MaskHash{}(m) & (slots.size() - 1);
+    while (slots[h] && !(nodes[slots[h] - 1].state == m)) h = (h + 1) & (slots.size() - 1);
+    return h;
+  };
+  const auto grow = [&] {
+    std::vector<std::uint32_t> old(slots.size() * 2, 0);
+    old.swap(slots);
+    for (const std::uint32_t n : old)
+      if (n) slots[slot_of(nodes[n - 1].state)] = n;
+  };
   const auto goal = [&](const Mask& m) { return (m & pr.must_in) == pr.must_in && !(m & pr.must_out).any(); };
   // Every successor of a node (-1: the start), until the goal or the limit.
   const auto expand = [&](int at) {
     const bool first = at < 0;
     const Mask state = first ? Mask{} : nodes[std::size_t(at)].state;
-    for (std::size_t i = 0; i < pr.primitives.size(); ++i) {
-      const ProjectedPrimitive<W>& q = pr.primitives[i];
+    for (const ProjectedPrimitive<W>& q : pr.primitives) {
       Mask next;
-      if (!(first ? q.first : q.later) || !step(q, state, first, next) || (next & pr.stuck).any() || seen.count(next))
-        continue;
+      if (!(first ? q.first : q.later) || !step(q, state, first, next)) continue;
+      const std::size_t h = slot_of(next);
+      if (slots[h]) continue;
       if (++states > max_states) return Search::Limit;
-      seen.emplace(next, int(nodes.size()));
       nodes.push_back({next, at, q.index});
+      slots[h] = std::uint32_t(nodes.size());
       if (goal(next)) {
         sequence.clear();
         for (int n = int(nodes.size()) - 1; n >= 0; n = nodes[std::size_t(n)].parent)
@@ -204,14 +213,13 @@ Search search_projection(const Projection<W>& pr, std::int64_t max_states, std::
         std::reverse(sequence.begin(), sequence.end());
         return Search::Plan;
       }
-      queue.push_back(int(nodes.size()) - 1);
+      if (nodes.size() * 2 > slots.size()) grow();
     }
     return Search::NoPlan;
   };
-  for (int at = -1;; at = queue.front(), queue.pop_front()) {
+  for (int at = -1; at < int(nodes.size()); ++at)
     if (const Search s = expand(at); s != Search::NoPlan) return s;
-    if (queue.empty()) return Search::NoPlan;
-  }
+  return Search::NoPlan;
 }
 
 // Where a projected plan goes wrong in the whole problem: the atoms outside S that show it
