@@ -231,41 +231,53 @@ struct Replay {
   std::vector<int> atoms;
 };
 
-// The atoms that keep a deposit from being taken in `state`: one atom out of reach and
-// what blocks it, or else the atom of a first layer with the fewest that could carry it,
-// and those (a few only: S stays small).
-std::vector<int> why_refused(const PlanningProblem& p, const PrimitiveSpec& prim, const AtomSet& state, bool first) {
+// The atoms that keep a deposit from being taken in `state`: an atom out of reach and a
+// present atom that blocks it, or an atom of a first layer and all that could carry it;
+// of these, the explanation that adds the fewest atoms to S (`in_s`): S stays small, and
+// the projected states with it.
+std::vector<int> why_refused(const PlanningProblem& p, const PrimitiveSpec& prim, const AtomSet& state, bool first,
+                             const std::vector<char>& in_s) {
   constexpr int kMostCarriers = 256;
   const auto& s = state.words();
   const auto& a = prim.atoms.words();
   const auto& short_of = prim.falls_short.words();
-  int floating = -1, fewest = kMostCarriers + 1;
+  std::vector<int> best;
+  int fewest = kMostCarriers + 2;
+  const auto consider = [&](std::vector<int> why) {
+    int added = 0;
+    for (const int x : why) added += in_s[std::size_t(x)] == 0;
+    if (added < fewest) fewest = added, best = std::move(why);
+  };
   for (std::size_t w = 0; w < a.size(); ++w) {
     const std::uint64_t does = !first && w < short_of.size() ? a[w] & ~short_of[w] : a[w];
     for (std::uint64_t b = does & ~s[w]; b; b &= b - 1) {
       const int atom = int(w * 64) + std::countr_zero(b);
       if (prim.blocked_by && prim.blocked_by->meets(std::size_t(atom), s)) {
         const auto& blockers = (*prim.blocked_by)[std::size_t(atom)].words();
+        int blocker = -1;  // a present one, in S when one is
         for (std::size_t v = 0; v < blockers.size(); ++v)
-          if (const std::uint64_t hit = blockers[v] & s[v]) return {atom, int(v * 64) + std::countr_zero(hit)};
+          for (std::uint64_t hit = blockers[v] & s[v]; hit; hit &= hit - 1) {
+            const int x = int(v * 64) + std::countr_zero(hit);
+            if (blocker < 0 || (in_s[std::size_t(x)] && !in_s[std::size_t(blocker)])) blocker = x;
+          }
+        consider({atom, blocker});
       }
       if (first || !prim.footing || prim.footing->kind[std::size_t(atom)] != DepositFooting::NeedsCarrier ||
           prim.footing->carriers.meets(std::size_t(atom), s))
         continue;
-      const int n = members(prim.footing->carriers[std::size_t(atom)]);
-      if (n < fewest) fewest = n, floating = atom;
+      const AtomSet& carriers = prim.footing->carriers[std::size_t(atom)];
+      if (members(carriers) > kMostCarriers) continue;
+      std::vector<int> why{atom};
+      for (int c = 0; c < int(p.atoms.size()) && !carriers.words().empty(); ++c)
+        if (carriers.test(c)) why.push_back(c);
+      consider(std::move(why));
     }
   }
-  if (floating < 0) return {};
-  std::vector<int> why{floating};
-  const AtomSet& carriers = prim.footing->carriers[std::size_t(floating)];
-  for (int c = 0; c < int(p.atoms.size()) && !carriers.words().empty(); ++c)
-    if (carriers.test(c)) why.push_back(c);
-  return why;
+  return best;
 }
 
 Replay replay(const PlanningProblem& p, const std::vector<int>& sequence, const std::vector<int>& fixers,
-              int atoms_per_round) {
+              const std::vector<char>& in_s, int atoms_per_round) {
   Replay r;
   AtomSet state(int(p.atoms.size()));
   bool first = true;
@@ -277,7 +289,7 @@ Replay replay(const PlanningProblem& p, const std::vector<int>& sequence, const 
     AtomSet next;
     double volume = 0;
     if (!detail::apply(p, state, i, next, volume, first)) {
-      r.atoms = why_refused(p, p.primitives[std::size_t(i)], state, first);
+      r.atoms = why_refused(p, p.primitives[std::size_t(i)], state, first, in_s);
       return r;
     }
     state = std::move(next);
@@ -333,7 +345,7 @@ CoreProof prove_by_core(const PlanningProblem& p, const CoreProofLimits& limits)
       std::sort(proof.core.begin(), proof.core.end());
       return proof;
     }
-    Replay r = replay(p, sequence, fixers, limits.atoms_per_round);
+    Replay r = replay(p, sequence, fixers, in_s, limits.atoms_per_round);
     if (r.goal && r.too_many_uses) return proof;
     if (r.goal) {
       proof.outcome = CoreProof::Outcome::Feasible;

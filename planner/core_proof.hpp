@@ -24,7 +24,7 @@ inline constexpr int kCoreWords = 8;  // S is at most 64 x this many atoms
 struct CoreProofLimits {
   int max_atoms = 64 * kCoreWords;     // S is at most this big
   int atoms_per_round = 1;             // wrong atoms of a replay's end state that join S
-  std::int64_t max_states = 2'000'000;  // projected states reached, summed over the rounds
+  std::int64_t max_states = 4'000'000;  // projected states reached, summed over the rounds
 };
 
 struct CoreProof {
