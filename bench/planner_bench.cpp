@@ -13,6 +13,7 @@
 #include "geometry/voxelize.hpp"
 #include "planner/atoms.hpp"
 #include "planner/planning.hpp"
+#include "planner/core_proof.hpp"
 #include "planner/search.hpp"
 #include "planner/search_reduce.hpp"
 #include "bench/baseline_astar.hpp"
@@ -196,6 +197,25 @@ BENCHMARK(BM_SearchMachine)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(1);
+
+// The proof from a few atoms that no plan exists (planner/core_proof.hpp) on the same
+// recorded problems, as `plan` runs it before the search: outcome 0 proven, 1 a replayed
+// plan makes the part, 2 the limits. Compare its time with BM_SearchMachine's in the same
+// run: on the overhang the search stops at its limits without a plan.
+void BM_CoreProof(benchmark::State& state) {
+  const std::string part = kMachineProblems[state.range(0)];
+  const auto p = bench::problem_of_plan_json(std::string(HYBRIDCTL_SOURCE_DIR) + "/bench/data/" + part +
+                                             "-b-axis-0.5.problem.json");
+  planner::CoreProof proof;
+  for (auto _ : state) proof = planner::prove_by_core(p);
+  state.SetLabel(part);
+  state.counters["outcome"] = double(int(proof.outcome));
+  state.counters["core_atoms"] = double(proof.core.size());
+  state.counters["rounds"] = double(proof.rounds);
+  state.counters["states"] = double(proof.states);
+}
+
+BENCHMARK(BM_CoreProof)->DenseRange(0, 1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_Exhaustive(benchmark::State& state) {
   const auto p = synthetic_problem(int(state.range(0)), std::uint32_t(state.range(1)));
