@@ -183,8 +183,11 @@ Verdict core_verdict(const PlanningProblem& p, const CoreProof& proof, const std
   v.summary = "no sequence of the " + std::to_string(p.primitives.size()) +
               " primitives gets these " + std::to_string(proof.core.size()) + " atoms right together (" +
               std::to_string(design) + " of the design), whatever the other atoms do: deposits cannot reach under "
-              "material already there or lay a first layer on nothing, and removals cut what they hold (proven over " +
-              std::to_string(proof.states) + " states of " + std::to_string(proof.rounds) + " projections)";
+              "material already there or lay a first layer on nothing, and removals cut what they hold (" +
+              std::to_string(proof.joined[0]) + " of the atoms showed a deposit out of reach, " +
+              std::to_string(proof.joined[1]) + " a first layer with nothing under it, " + std::to_string(proof.joined[2]) +
+              " were wrong at the end of a plan; proven over " + std::to_string(proof.states) + " states of " +
+              std::to_string(proof.rounds) + " projections)";
   return v;
 }
 

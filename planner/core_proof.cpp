@@ -229,6 +229,7 @@ struct Replay {
   bool too_many_uses = false;  // a primitive used more than max_uses times (before the goal)
   std::size_t steps = 0;  // on goal: the steps taken when it was first reached
   std::vector<int> atoms;
+  CoreProof::Why why = CoreProof::Why::WrongAtTheEnd;
 };
 
 // The atoms that keep a deposit from being taken in `state`: an atom out of reach and a
@@ -236,17 +237,17 @@ struct Replay {
 // of these, the explanation that adds the fewest atoms to S (`in_s`): S stays small, and
 // the projected states with it.
 std::vector<int> why_refused(const PlanningProblem& p, const PrimitiveSpec& prim, const AtomSet& state, bool first,
-                             const std::vector<char>& in_s) {
+                             const std::vector<char>& in_s, CoreProof::Why& why_kind) {
   constexpr int kMostCarriers = 256;
   const auto& s = state.words();
   const auto& a = prim.atoms.words();
   const auto& short_of = prim.falls_short.words();
   std::vector<int> best;
   int fewest = kMostCarriers + 2;
-  const auto consider = [&](std::vector<int> why) {
+  const auto consider = [&](std::vector<int> why, CoreProof::Why kind) {
     int added = 0;
     for (const int x : why) added += in_s[std::size_t(x)] == 0;
-    if (added < fewest) fewest = added, best = std::move(why);
+    if (added < fewest) fewest = added, best = std::move(why), why_kind = kind;
   };
   for (std::size_t w = 0; w < a.size(); ++w) {
     const std::uint64_t does = !first && w < short_of.size() ? a[w] & ~short_of[w] : a[w];
@@ -260,7 +261,7 @@ std::vector<int> why_refused(const PlanningProblem& p, const PrimitiveSpec& prim
             const int x = int(v * 64) + std::countr_zero(hit);
             if (blocker < 0 || (in_s[std::size_t(x)] && !in_s[std::size_t(blocker)])) blocker = x;
           }
-        consider({atom, blocker});
+        consider({atom, blocker}, CoreProof::Why::OutOfReach);
       }
       if (first || !prim.footing || prim.footing->kind[std::size_t(atom)] != DepositFooting::NeedsCarrier ||
           prim.footing->carriers.meets(std::size_t(atom), s))
@@ -270,7 +271,7 @@ std::vector<int> why_refused(const PlanningProblem& p, const PrimitiveSpec& prim
       std::vector<int> why{atom};
       for (int c = 0; c < int(p.atoms.size()) && !carriers.words().empty(); ++c)
         if (carriers.test(c)) why.push_back(c);
-      consider(std::move(why));
+      consider(std::move(why), CoreProof::Why::NothingUnder);
     }
   }
   return best;
@@ -289,7 +290,7 @@ Replay replay(const PlanningProblem& p, const std::vector<int>& sequence, const 
     AtomSet next;
     double volume = 0;
     if (!detail::apply(p, state, i, next, volume, first)) {
-      r.atoms = why_refused(p, p.primitives[std::size_t(i)], state, first, in_s);
+      r.atoms = why_refused(p, p.primitives[std::size_t(i)], state, first, in_s, r.why);
       return r;
     }
     state = std::move(next);
@@ -358,6 +359,7 @@ CoreProof prove_by_core(const PlanningProblem& p, const CoreProofLimits& limits)
     std::erase_if(r.atoms, [&](int a) { return in_s[std::size_t(a)] != 0; });
     if (r.atoms.empty() || int(s.size() + r.atoms.size()) > limits.max_atoms) return proof;
     for (const int a : r.atoms) s.push_back(a), in_s[std::size_t(a)] = 1;
+    proof.joined[int(r.why)] += int(r.atoms.size());
   }
 }
 

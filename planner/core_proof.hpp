@@ -36,6 +36,10 @@ struct CoreProof {
   // Feasible: primitives, in order, that make the whole goal (each used at most max_uses
   // times). Unknown: the limits were reached, or a projected plan's failure named no atom.
   std::vector<int> sequence;
+  // Why atoms joined S: a replayed deposit out of the head's reach, a first layer with
+  // nothing under it, or atoms wrong at the end of a replayed plan; how many for each.
+  enum class Why { OutOfReach, NothingUnder, WrongAtTheEnd };
+  int joined[3] = {0, 0, 0};
   int rounds = 0;             // projections searched
   std::int64_t states = 0;    // projected states reached, over the rounds
 };
