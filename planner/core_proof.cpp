@@ -75,6 +75,39 @@ int members(const AtomSet& set) {
   return n;
 }
 
+// What the projection looks through: atoms, and groups of carriers. A group's bit stands
+// for "some atom of it may be present": a deposit that holds one of them sets it, a removal
+// that holds them all clears it, nothing else does. Whenever one of its atoms is present
+// in the whole problem, the bit is set; so a first layer whose every carrier is in S or in
+// such a group, with none of those bits set, has nothing under it. One bit where the atoms
+// would be tens of them: the projected states stay few.
+struct Core {
+  std::vector<int> atoms;          // bit k: atoms[k]
+  std::vector<AtomSet> groups;     // bit atoms.size() + g: groups[g]
+  std::vector<char> has;           // per atom of the problem: in `atoms`
+  std::size_t size() const { return atoms.size() + groups.size(); }
+  int group_of(const AtomSet& c) const {
+    for (std::size_t g = 0; g < groups.size(); ++g)
+      if (groups[g] == c) return int(g);
+    return -1;
+  }
+};
+
+bool meets(const AtomSet& a, const AtomSet& b, const AtomSet& less) {
+  const auto &x = a.words(), &y = b.words(), &z = less.words();
+  for (std::size_t w = 0; w < x.size() && w < y.size(); ++w)
+    if (x[w] & y[w] & ~(w < z.size() ? z[w] : 0)) return true;
+  return false;
+}
+
+// Whether every member of `c` is in `a` less `less`.
+bool holds_all(const AtomSet& a, const AtomSet& c, const AtomSet& less) {
+  const auto &x = a.words(), &y = c.words(), &z = less.words();
+  for (std::size_t w = 0; w < y.size(); ++w)
+    if (y[w] & ~((w < x.size() ? x[w] : 0) & ~(w < z.size() ? z[w] : 0))) return false;
+  return true;
+}
+
 // A primitive as the projection on S sees it.
 template <int W>
 struct ProjectedPrimitive {
@@ -110,8 +143,11 @@ struct Projection {
 };
 
 template <int W>
-Projection<W> project(const PlanningProblem& p, const std::vector<int>& s) {
+Projection<W> project(const PlanningProblem& p, const Core& core) {
   using Mask = hybridctl::planner::Mask<W>;
+  const std::vector<int>& s = core.atoms;
+  const std::size_t a0 = s.size();  // the first group's bit
+  const AtomSet none;
   Projection<W> pr;
   for (std::size_t k = 0; k < s.size(); ++k) {
     if (p.atoms[std::size_t(s[k])].must_in) pr.must_in.set(k);
@@ -127,15 +163,28 @@ Projection<W> project(const PlanningProblem& p, const std::vector<int>& s) {
     q.later = detail::allowed(p, int(i), false, no_uses);
     q.all = bits_in<W>(prim.atoms, s);
     q.begun = q.all & ~bits_in<W>(prim.falls_short, s);
+    for (std::size_t g = 0; g < core.groups.size(); ++g) {
+      const AtomSet& c = core.groups[g];
+      if (q.additive ? meets(prim.atoms, c, none) : holds_all(prim.atoms, c, none)) q.all.set(a0 + g);
+      if (q.additive ? meets(prim.atoms, c, prim.falls_short) : holds_all(prim.atoms, c, prim.falls_short))
+        q.begun.set(a0 + g);
+    }
     for (std::size_t k = 0; k < s.size() && q.additive; ++k) {
       if (!q.all.test(k)) continue;
       if (const Mask over = prim.blocked_by ? bits_in<W>((*prim.blocked_by)[std::size_t(s[k])], s) : Mask{}; over.any())
         q.blocked.set(k), q.blockers.push_back({k, over});
       if (!prim.footing || prim.footing->kind[std::size_t(s[k])] != DepositFooting::NeedsCarrier) continue;
-      // A carrier outside S is taken as present: only carriers all in S can be missing.
+      // A carrier outside S is taken as present: only carriers all in S, or in a group
+      // of S, can be missing.
       const AtomSet& carriers = prim.footing->carriers[std::size_t(s[k])];
-      const Mask in_s = bits_in<W>(carriers, s);
-      if (in_s.count() == members(carriers)) q.carried.set(k), q.carriers.push_back({k, in_s});
+      Mask in_s = bits_in<W>(carriers, s);
+      const bool exact = in_s.count() == members(carriers);
+      if (!exact) {  // the group's bit only where the atoms do not tell (it may be set with none present)
+        const int g = core.group_of(carriers);
+        if (g < 0) continue;
+        in_s.set(a0 + std::size_t(g));
+      }
+      q.carried.set(k), q.carriers.push_back({k, in_s});
     }
     if (std::none_of(pr.primitives.begin(), pr.primitives.end(), [&](const ProjectedPrimitive<W>& o) { return o.same(q); }))
       pr.primitives.push_back(std::move(q));
@@ -222,32 +271,39 @@ Search search_projection(const Projection<W>& pr, std::int64_t max_states, std::
   return Search::NoPlan;
 }
 
+// Atoms and carrier groups that join S, and why.
+struct Explanation {
+  std::vector<int> atoms;
+  std::vector<AtomSet> groups;
+  CoreProof::Why why = CoreProof::Why::WrongAtTheEnd;
+};
+
 // Where a projected plan goes wrong in the whole problem: the atoms outside S that show it
 // (empty with `goal` when it makes the part, empty without when nothing explains it).
 struct Replay {
   bool goal = false;
   bool too_many_uses = false;  // a primitive used more than max_uses times (before the goal)
   std::size_t steps = 0;  // on goal: the steps taken when it was first reached
-  std::vector<int> atoms;
-  CoreProof::Why why = CoreProof::Why::WrongAtTheEnd;
+  Explanation what;       // else: what joins S
 };
 
-// The atoms that keep a deposit from being taken in `state`: an atom out of reach and a
-// present atom that blocks it, or an atom of a first layer and all that could carry it;
-// of these, the explanation that adds the fewest atoms to S (`in_s`): S stays small, and
-// the projected states with it.
-std::vector<int> why_refused(const PlanningProblem& p, const PrimitiveSpec& prim, const AtomSet& state, bool first,
-                             const std::vector<char>& in_s, CoreProof::Why& why_kind) {
+// What keeps a deposit from being taken in `state`: an atom out of reach and a present
+// atom that blocks it, or an atom of a first layer and its carriers (as a group, or all of
+// them when the group is already in S); of these, the explanation that adds the fewest
+// members to S: S stays small, and the projected states with it.
+Explanation why_refused(const PlanningProblem& p, const PrimitiveSpec& prim, const AtomSet& state, bool first,
+                        const Core& core) {
   constexpr int kMostCarriers = 256;
   const auto& s = state.words();
   const auto& a = prim.atoms.words();
   const auto& short_of = prim.falls_short.words();
-  std::vector<int> best;
+  Explanation best;
   int fewest = kMostCarriers + 2;
-  const auto consider = [&](std::vector<int> why, CoreProof::Why kind) {
-    int added = 0;
-    for (const int x : why) added += in_s[std::size_t(x)] == 0;
-    if (added < fewest) fewest = added, best = std::move(why), why_kind = kind;
+  const auto consider = [&](Explanation e) {
+    int added = int(e.groups.size());
+    for (const int x : e.atoms) added += core.has[std::size_t(x)] == 0;
+    for (const AtomSet& g : e.groups) added -= core.group_of(g) >= 0;
+    if (added > 0 && added < fewest) fewest = added, best = std::move(e);
   };
   for (std::size_t w = 0; w < a.size(); ++w) {
     const std::uint64_t does = !first && w < short_of.size() ? a[w] & ~short_of[w] : a[w];
@@ -259,26 +315,27 @@ std::vector<int> why_refused(const PlanningProblem& p, const PrimitiveSpec& prim
         for (std::size_t v = 0; v < blockers.size(); ++v)
           for (std::uint64_t hit = blockers[v] & s[v]; hit; hit &= hit - 1) {
             const int x = int(v * 64) + std::countr_zero(hit);
-            if (blocker < 0 || (in_s[std::size_t(x)] && !in_s[std::size_t(blocker)])) blocker = x;
+            if (blocker < 0 || (core.has[std::size_t(x)] && !core.has[std::size_t(blocker)])) blocker = x;
           }
-        consider({atom, blocker}, CoreProof::Why::OutOfReach);
+        consider({{atom, blocker}, {}, CoreProof::Why::OutOfReach});
       }
       if (first || !prim.footing || prim.footing->kind[std::size_t(atom)] != DepositFooting::NeedsCarrier ||
           prim.footing->carriers.meets(std::size_t(atom), s))
         continue;
       const AtomSet& carriers = prim.footing->carriers[std::size_t(atom)];
+      consider({{atom}, {carriers}, CoreProof::Why::NothingUnder});
       if (members(carriers) > kMostCarriers) continue;
-      std::vector<int> why{atom};
+      Explanation each{{atom}, {}, CoreProof::Why::NothingUnder};
       for (int c = 0; c < int(p.atoms.size()) && !carriers.words().empty(); ++c)
-        if (carriers.test(c)) why.push_back(c);
-      consider(std::move(why), CoreProof::Why::NothingUnder);
+        if (carriers.test(c)) each.atoms.push_back(c);
+      consider(std::move(each));
     }
   }
   return best;
 }
 
 Replay replay(const PlanningProblem& p, const std::vector<int>& sequence, const std::vector<int>& fixers,
-              const std::vector<char>& in_s, int atoms_per_round) {
+              const Core& core, int atoms_per_round) {
   Replay r;
   AtomSet state(int(p.atoms.size()));
   bool first = true;
@@ -290,7 +347,7 @@ Replay replay(const PlanningProblem& p, const std::vector<int>& sequence, const 
     AtomSet next;
     double volume = 0;
     if (!detail::apply(p, state, i, next, volume, first)) {
-      r.atoms = why_refused(p, p.primitives[std::size_t(i)], state, first, in_s, r.why);
+      r.what = why_refused(p, p.primitives[std::size_t(i)], state, first, core);
       return r;
     }
     state = std::move(next);
@@ -310,7 +367,7 @@ Replay replay(const PlanningProblem& p, const std::vector<int>& sequence, const 
     return p.atoms[std::size_t(x)].volume > p.atoms[std::size_t(y)].volume;
   });
   wrong.resize(std::min(wrong.size(), std::size_t(atoms_per_round)));
-  r.atoms = std::move(wrong);
+  r.what.atoms = std::move(wrong);
   return r;
 }
 
@@ -330,23 +387,24 @@ std::vector<int> count_fixers(const PlanningProblem& p) {
 CoreProof prove_by_core(const PlanningProblem& p, const CoreProofLimits& limits) {
   CoreProof proof;
   const std::vector<int> fixers = count_fixers(p);
-  std::vector<int> s;
-  std::vector<char> in_s(p.atoms.size(), 0);
+  Core core;
+  core.has.assign(p.atoms.size(), 0);
   for (;;) {
     ++proof.rounds;
     std::vector<int> sequence;
-    const Search found = s.size() <= 64    ? search_projection(project<1>(p, s), limits.max_states, proof.states, sequence)
-                         : s.size() <= 128 ? search_projection(project<2>(p, s), limits.max_states, proof.states, sequence)
-                         : s.size() <= 256 ? search_projection(project<4>(p, s), limits.max_states, proof.states, sequence)
-                                           : search_projection(project<8>(p, s), limits.max_states, proof.states, sequence);
+    const std::size_t n = core.size();
+    const Search found = n <= 64    ? search_projection(project<1>(p, core), limits.max_states, proof.states, sequence)
+                         : n <= 128 ? search_projection(project<2>(p, core), limits.max_states, proof.states, sequence)
+                         : n <= 256 ? search_projection(project<4>(p, core), limits.max_states, proof.states, sequence)
+                                    : search_projection(project<8>(p, core), limits.max_states, proof.states, sequence);
     if (found == Search::Limit) return proof;
     if (found == Search::NoPlan) {
       proof.outcome = CoreProof::Outcome::Proven;
-      proof.core = s;
+      proof.core = core.atoms;
       std::sort(proof.core.begin(), proof.core.end());
       return proof;
     }
-    Replay r = replay(p, sequence, fixers, in_s, limits.atoms_per_round);
+    Replay r = replay(p, sequence, fixers, core, limits.atoms_per_round);
     if (r.goal && r.too_many_uses) return proof;
     if (r.goal) {
       proof.outcome = CoreProof::Outcome::Feasible;
@@ -354,12 +412,16 @@ CoreProof prove_by_core(const PlanningProblem& p, const CoreProofLimits& limits)
       proof.sequence = std::move(sequence);
       return proof;
     }
-    std::sort(r.atoms.begin(), r.atoms.end());  // an atom may carry itself: once in S
-    r.atoms.erase(std::unique(r.atoms.begin(), r.atoms.end()), r.atoms.end());
-    std::erase_if(r.atoms, [&](int a) { return in_s[std::size_t(a)] != 0; });
-    if (r.atoms.empty() || int(s.size() + r.atoms.size()) > limits.max_atoms) return proof;
-    for (const int a : r.atoms) s.push_back(a), in_s[std::size_t(a)] = 1;
-    proof.joined[int(r.why)] += int(r.atoms.size());
+    std::vector<int>& atoms = r.what.atoms;
+    std::sort(atoms.begin(), atoms.end());  // an atom may carry itself: once in S
+    atoms.erase(std::unique(atoms.begin(), atoms.end()), atoms.end());
+    std::erase_if(atoms, [&](int a) { return core.has[std::size_t(a)] != 0; });
+    std::erase_if(r.what.groups, [&](const AtomSet& g) { return core.group_of(g) >= 0; });
+    const std::size_t added = atoms.size() + r.what.groups.size();
+    if (added == 0 || int(core.size() + added) > limits.max_atoms) return proof;
+    for (const int a : atoms) core.atoms.push_back(a), core.has[std::size_t(a)] = 1;
+    for (AtomSet& g : r.what.groups) core.groups.push_back(std::move(g));
+    proof.joined[int(r.what.why)] += int(added);
   }
 }
 
