@@ -178,8 +178,11 @@ Verdict core_verdict(const PlanningProblem& p, const CoreProof& proof, const std
                      (names.empty() ? ", in no primitive" : ", in " + names);
     v.violations.push_back(std::move(va));
   }
-  std::sort(v.violations.begin(), v.violations.end(),
-            [](const ViolatingAtom& x, const ViolatingAtom& y) { return x.volume > y.volume; });
+  // The atoms fewest primitives hold first: what the part cannot get (a channel's roof, a
+  // slot's edge) before the base it stands on.
+  std::sort(v.violations.begin(), v.violations.end(), [](const ViolatingAtom& x, const ViolatingAtom& y) {
+    return x.primitives.size() != y.primitives.size() ? x.primitives.size() < y.primitives.size() : x.volume > y.volume;
+  });
   v.summary = "no sequence of the " + std::to_string(p.primitives.size()) +
               " primitives gets these " + std::to_string(proof.core.size()) + " atoms right together (" +
               std::to_string(design) + " of the design), whatever the other atoms do: deposits cannot reach under "

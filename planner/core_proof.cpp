@@ -220,7 +220,8 @@ enum class Search { NoPlan, Plan, Limit };
 // Breadth first over the projected states; on Plan, `sequence` reaches the projected goal.
 // `states` counts the states reached, and the search stops when it passes `max_states`.
 template <int W>
-Search search_projection(const Projection<W>& pr, std::int64_t max_states, std::int64_t& states, std::vector<int>& sequence) {
+Search search_projection(const Projection<W>& pr, const CoreProofLimits& limits, std::int64_t& states,
+                         std::vector<int>& sequence) {
   using Mask = hybridctl::planner::Mask<W>;
   struct Node {
     Mask state;
@@ -252,7 +253,7 @@ Search search_projection(const Projection<W>& pr, std::int64_t max_states, std::
       if (!(first ? q.first : q.later) || !step(q, state, first, next)) continue;
       const std::size_t h = slot_of(next);
       if (slots[h]) continue;
-      if (++states > max_states) return Search::Limit;
+      if (++states > limits.max_states || (limits.stop && states % 4096 == 0 && limits.stop->load())) return Search::Limit;
       nodes.push_back({next, at, q.index});
       slots[h] = std::uint32_t(nodes.size());
       if (goal(next)) {
@@ -393,10 +394,10 @@ CoreProof prove_by_core(const PlanningProblem& p, const CoreProofLimits& limits)
     ++proof.rounds;
     std::vector<int> sequence;
     const std::size_t n = core.size();
-    const Search found = n <= 64    ? search_projection(project<1>(p, core), limits.max_states, proof.states, sequence)
-                         : n <= 128 ? search_projection(project<2>(p, core), limits.max_states, proof.states, sequence)
-                         : n <= 256 ? search_projection(project<4>(p, core), limits.max_states, proof.states, sequence)
-                                    : search_projection(project<8>(p, core), limits.max_states, proof.states, sequence);
+    const Search found = n <= 64    ? search_projection(project<1>(p, core), limits, proof.states, sequence)
+                         : n <= 128 ? search_projection(project<2>(p, core), limits, proof.states, sequence)
+                         : n <= 256 ? search_projection(project<4>(p, core), limits, proof.states, sequence)
+                                    : search_projection(project<8>(p, core), limits, proof.states, sequence);
     if (found == Search::Limit) return proof;
     if (found == Search::NoPlan) {
       proof.outcome = CoreProof::Outcome::Proven;

@@ -12,6 +12,7 @@
 // it goes wrong (a deposit out of reach, a first layer with nothing under it, atoms wrong
 // at the end) the atoms that show it join S. A replay that reaches the goal is a plan.
 
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -21,10 +22,17 @@ namespace hybridctl::planner {
 
 inline constexpr int kCoreWords = 8;  // S is at most 64 x this many atoms
 
+// The budget of the proof `plan` runs beside the search when the one before it stopped at
+// its budget: about 20 s and 0.6 GB at most on the bundled parts.
+inline constexpr std::int64_t kLongerProofStates = 24'000'000;
+
 struct CoreProofLimits {
   int max_atoms = 64 * kCoreWords;     // S is at most this big
   int atoms_per_round = 1;             // wrong atoms of a replay's end state that join S
   std::int64_t max_states = 4'000'000;  // projected states reached, summed over the rounds
+  // When set, asked every few thousand states: true gives up (Unknown), e.g. when a search
+  // running beside the proof has found plans.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 struct CoreProof {

@@ -2,6 +2,7 @@
 #include "planner/toolpath_rank.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -10,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <thread>
 
 #include "common/error.hpp"
 #include "common/number_text.hpp"
@@ -475,6 +477,40 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
   }
 }
 
+// When the proof before the search stopped at its budget, a longer one runs on another
+// core while the search does: it decides the parts the search cannot (the B-axis
+// thin-wall slot: 17 million projected states), and is stopped as soon as the search has
+// a plan. It works on its own copy of the problem, the one before any learning: the search
+// corrects its problem as candidates fail.
+void search_beside_a_longer_proof(int top_k, const PlanningOptions& options, const Progress& progress,
+                                  PlanningResult& r, double& validation_seconds) {
+  if (r.core_proof.outcome != CoreProof::Outcome::Unknown || r.verdict.modality != Modality::Hybrid) {
+    search_plans(top_k, options, progress, r, validation_seconds);
+    return;
+  }
+  std::atomic<bool> stop{false};
+  CoreProofLimits limits;
+  limits.max_states = kLongerProofStates;
+  limits.stop = &stop;
+  const PlanningProblem problem = r.problem;
+  CoreProof longer;
+  std::thread prover([&] { longer = prove_by_core(problem, limits); });
+  try {
+    search_plans(top_k, options, progress, r, validation_seconds);
+  } catch (...) {
+    stop = true;
+    prover.join();
+    throw;
+  }
+  if (!r.plans.empty()) stop = true;
+  prover.join();
+  if (!r.plans.empty() || longer.outcome != CoreProof::Outcome::Proven) return;
+  r.core_proof = std::move(longer);
+  r.verdict = core_verdict(problem, r.core_proof, r.measures, r.lattice);
+  r.search.limit_reached = false;
+  r.search.exhausted = true;
+}
+
 }  // namespace
 
 PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& part_name,
@@ -520,7 +556,7 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
     if (r.core_proof.outcome == CoreProof::Outcome::Proven) r.verdict = core_verdict(r.problem, r.core_proof, r.measures, r.lattice);
     clock.lap("proof");
   }
-  if (r.verdict.manufacturable) search_plans(top_k, options, progress, r, validation_seconds);
+  if (r.verdict.manufacturable) search_beside_a_longer_proof(top_k, options, progress, r, validation_seconds);
   clock.lap("search");
   if (r.validated) {
     // The search's lap holds the validation it called: report them apart.
