@@ -10,6 +10,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <new>
 #include <set>
 #include <thread>
 
@@ -494,7 +495,13 @@ void search_beside_a_longer_proof(int top_k, const PlanningOptions& options, con
   limits.stop = &stop;
   const PlanningProblem problem = r.problem;
   CoreProof longer;
-  std::thread prover([&] { longer = prove_by_core(problem, limits); });
+  std::thread prover([&] {
+    try {
+      longer = prove_by_core(problem, limits);
+    } catch (const std::bad_alloc&) {
+      longer = {};  // out of memory: no verdict from it, the search's stands
+    }
+  });
   try {
     search_plans(top_k, options, progress, r, validation_seconds);
   } catch (...) {
