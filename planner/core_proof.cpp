@@ -335,8 +335,7 @@ Explanation why_refused(const PlanningProblem& p, const PrimitiveSpec& prim, con
   return best;
 }
 
-Replay replay(const PlanningProblem& p, const std::vector<int>& sequence, const std::vector<int>& fixers,
-              const Core& core, int atoms_per_round) {
+Replay replay(const PlanningProblem& p, const std::vector<int>& sequence, const Core& core, int atoms_per_round) {
   Replay r;
   AtomSet state(int(p.atoms.size()));
   bool first = true;
@@ -356,38 +355,24 @@ Replay replay(const PlanningProblem& p, const std::vector<int>& sequence, const 
     ++r.steps;
     if (is_goal(p, state)) return r.goal = true, r;
   }
-  // Atoms wrong at the end: the most constrained first (fewest primitives that could put
-  // them right), then the largest.
+  // Atoms wrong at the end: the largest first (docs/search.md: with carriers as groups,
+  // this needs the fewest projected states on the bundled parts).
   std::vector<int> wrong;
   for (int a = 0; a < int(p.atoms.size()); ++a) {
     const AtomSpec& spec = p.atoms[std::size_t(a)];
     if (spec.must_in != state.test(a) && (spec.must_in || spec.must_out)) wrong.push_back(a);
   }
-  std::sort(wrong.begin(), wrong.end(), [&](int x, int y) {
-    if (fixers[std::size_t(x)] != fixers[std::size_t(y)]) return fixers[std::size_t(x)] < fixers[std::size_t(y)];
-    return p.atoms[std::size_t(x)].volume > p.atoms[std::size_t(y)].volume;
-  });
+  std::stable_sort(wrong.begin(), wrong.end(),
+                   [&](int x, int y) { return p.atoms[std::size_t(x)].volume > p.atoms[std::size_t(y)].volume; });
   wrong.resize(std::min(wrong.size(), std::size_t(atoms_per_round)));
   r.what.atoms = std::move(wrong);
   return r;
-}
-
-// Per atom, how many primitives could put it right: deposits holding a must-in atom,
-// removals holding a must-out one.
-std::vector<int> count_fixers(const PlanningProblem& p) {
-  std::vector<int> fixers(p.atoms.size(), 0);
-  for (const PrimitiveSpec& prim : p.primitives)
-    for (std::size_t a = 0; a < p.atoms.size(); ++a)
-      if (prim.atoms.test(int(a)) && (prim.mode == Mode::Additive ? p.atoms[a].must_in : p.atoms[a].must_out))
-        ++fixers[a];
-  return fixers;
 }
 
 }  // namespace
 
 CoreProof prove_by_core(const PlanningProblem& p, const CoreProofLimits& limits) {
   CoreProof proof;
-  const std::vector<int> fixers = count_fixers(p);
   Core core;
   core.has.assign(p.atoms.size(), 0);
   for (;;) {
@@ -405,7 +390,7 @@ CoreProof prove_by_core(const PlanningProblem& p, const CoreProofLimits& limits)
       std::sort(proof.core.begin(), proof.core.end());
       return proof;
     }
-    Replay r = replay(p, sequence, fixers, core, limits.atoms_per_round);
+    Replay r = replay(p, sequence, core, limits.atoms_per_round);
     if (r.goal && r.too_many_uses) return proof;
     if (r.goal) {
       proof.outcome = CoreProof::Outcome::Feasible;

@@ -23,7 +23,7 @@ namespace hybridctl::planner {
 inline constexpr int kCoreWords = 8;  // S is at most 64 x this many atoms
 
 // The budget of the proof `plan` runs beside the search when the one before it stopped at
-// its budget: about 20 s and 0.6 GB at most on the bundled parts.
+// its budget: about 20-30 s and at most about 1 GB (no bundled part needs it).
 inline constexpr std::int64_t kLongerProofStates = 24'000'000;
 
 struct CoreProofLimits {
