@@ -42,12 +42,6 @@ struct Mask {
     return a;
   }
   friend bool operator==(const Mask&, const Mask&) = default;
-  // Calls f(k) for each member k.
-  template <typename F>
-  void each(F f) const {
-    for (std::size_t i = 0; i < w.size(); ++i)
-      for (std::uint64_t b = w[i]; b; b &= b - 1) f(i * 64 + std::size_t(std::countr_zero(b)));
-  }
 };
 
 struct MaskHash {

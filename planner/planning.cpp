@@ -480,8 +480,8 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
 
 // When the proof before the search stopped at its budget, a longer one runs on another
 // core while the search does: it decides parts the search cannot, and is stopped as soon
-// as the search has a plan. It works on its own copy of the problem, the one before any learning: the search
-// corrects its problem as candidates fail.
+// as the search has a plan. It works on its own copy of the problem, the one before any
+// learning: the search corrects its problem as candidates fail.
 void search_beside_a_longer_proof(int top_k, const PlanningOptions& options, const Progress& progress,
                                   PlanningResult& r, double& validation_seconds) {
   if (r.core_proof.outcome != CoreProof::Outcome::Unknown || r.verdict.modality != Modality::Hybrid) {
