@@ -381,7 +381,7 @@ std::string learned_text(const PlanningResult& r) {
          (primitives.size() == 1 ? "" : "s") + " falling short of the model on " + std::to_string(r.learned.size()) +
          " atom" + (r.learned.size() == 1 ? "" : "s") + " (" + trimmed_number(volume, 1) + " mm\u00B3; largest " + where +
          ", by " + r.problem.primitives[std::size_t(largest->primitive)].name + "), taken out of them over " +
-         std::to_string(r.search_rounds) + " searches";
+         std::to_string(r.search_rounds) + (r.search_rounds == 1 ? " search" : " searches");
 }
 
 namespace {
@@ -413,6 +413,7 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
   r.validated = bool(options.validate);
   const auto started = std::chrono::steady_clock::now();
   SearchStats total;
+  bool proven_after_learning = false;
   for (;;) {
     ++r.search_rounds;
     SearchStats round;
@@ -434,6 +435,15 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
       r.learned.push_back(s);
     }
     learning.pending.clear();
+    // What execution showed may leave the corrected problem with no plan at all: the proof
+    // says so in a moment, where the next search would run to its limit.
+    CoreProof corrected = prove_by_core(r.problem);
+    if (corrected.outcome == CoreProof::Outcome::Proven) {
+      r.plans.clear();
+      r.core_proof = std::move(corrected);
+      proven_after_learning = true;
+      break;
+    }
     // The rounds share the budgets: turned-down plans and seconds.
     search.max_rejected = std::max<std::int64_t>(1, options.max_rejected - total.rejected);
     if (options.search_time > 0)
@@ -441,6 +451,20 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
           0.05, options.search_time - std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
   }
   r.search = total;
+  if (proven_after_learning) {
+    r.search.limit_reached = false;
+    r.search.exhausted = true;
+    // A correction is not a proof (docs/validation.md): the verdict stays undecided, and
+    // says that the search is over and why.
+    r.verdict = core_verdict(r.problem, r.core_proof, r.measures, r.lattice);
+    r.verdict.decided_without_search = false;
+    r.verdict.summary = "no plan is left once the primitives are corrected by what execution showed (" +
+                        std::to_string(r.rejected.size()) + " candidate" + (r.rejected.size() == 1 ? "" : "s") +
+                        " rejected; " + learned_text(r) + "): on the corrected primitives, " + r.verdict.summary +
+                        ". The correction may also rule out plans that would work";
+    progress("search", 1);
+    return;
+  }
   std::string undecided_hint;
   if (r.plans.empty() && r.search.limit_reached && !r.verdict.decided_without_search) {
     // The search stopped without a plan: maybe none exists. Exploring what the primitives

@@ -6,21 +6,43 @@
 
 namespace hybridctl::planner {
 
-std::vector<Shortfall> find_shortfalls(const PlanningProblem& problem, const AtomDecomposition& atoms, const Plan& plan,
-                                       std::size_t steps, const geometry::Solid& built) {
-  const int n = atoms.atom_count();
-  // The plan's state after `steps` actions, and per atom the step that last changed it.
-  std::vector<int> last(std::size_t(n), -1);
-  AtomSet state(n);
+namespace {
+
+// The plan's state after `steps` actions, and per atom the step that last changed it.
+struct PlannedState {
+  AtomSet state;
+  std::vector<int> last;
+};
+
+PlannedState planned_state(const PlanningProblem& problem, int n, const Plan& plan, std::size_t steps) {
+  PlannedState out{AtomSet(n), std::vector<int>(std::size_t(n), -1)};
   for (std::size_t s = 0; s < std::min(steps, plan.steps.size()); ++s) {
     const PrimitiveSpec& prim = problem.primitives[std::size_t(plan.steps[s].primitive)];
     const bool adds = prim.mode == Mode::Additive;
     for (int a = 0; a < n; ++a)
-      if (prim.atoms.test(a) && state.test(a) != adds) {
-        state.set(a, adds);
-        last[std::size_t(a)] = int(s);
+      if (prim.atoms.test(a) && out.state.test(a) != adds) {
+        out.state.set(a, adds);
+        out.last[std::size_t(a)] = int(s);
       }
   }
+  return out;
+}
+
+double atom_volume(const AtomDecomposition& atoms, int atom) {
+  std::int64_t voxels = 0;
+  const IndexBox& d = atoms.domain();
+  for (int z = d.lo.z; z < d.hi.z; ++z)
+    for (int y = d.lo.y; y < d.hi.y; ++y)
+      for (int x = 0; x < d.hi.x - d.lo.x; ++x) voxels += atoms.atom_at_unchecked(x, y, z) == atom;
+  return double(voxels) * std::pow(atoms.lattice().voxel_size, 3);
+}
+
+}  // namespace
+
+std::vector<Shortfall> find_shortfalls(const PlanningProblem& problem, const AtomDecomposition& atoms, const Plan& plan,
+                                       std::size_t steps, const geometry::Solid& built) {
+  const int n = atoms.atom_count();
+  const auto [state, last] = planned_state(problem, n, plan, steps);
   std::vector<std::int64_t> voxels(std::size_t(n), 0), present(std::size_t(n), 0);
   const IndexBox& d = atoms.domain();
   for (int z = d.lo.z; z < d.hi.z; ++z)
@@ -45,6 +67,64 @@ std::vector<Shortfall> find_shortfalls(const PlanningProblem& problem, const Ato
     const bool missing = spec.must_in && state.test(a) && built_fraction < 0.5;
     const bool left = spec.must_out && !state.test(a) && built_fraction > 0.5;
     if (missing || left) out.push_back({primitive, a, double(voxels[std::size_t(a)]) * voxel_volume});
+  }
+  return out;
+}
+
+std::vector<Shortfall> find_missing_core_shortfalls(const PlanningProblem& problem, const AtomDecomposition& atoms,
+                                                    const Plan& plan, std::size_t steps, const geometry::Solid& missing) {
+  const std::size_t executed = std::min(steps, plan.steps.size());
+  const int n = atoms.atom_count();
+  const auto [state, last] = planned_state(problem, n, plan, executed);
+  const auto removal_after = [&](int s) {
+    for (std::size_t k = std::size_t(s) + 1; k < executed; ++k)
+      if (problem.primitives[std::size_t(plan.steps[k].primitive)].mode == Mode::Subtractive) return true;
+    return false;
+  };
+  std::vector<char> charged(std::size_t(n), 0);
+  std::vector<Shortfall> out;
+  missing.for_each_voxel([&](Index3 v) {
+    if (!atoms.domain().contains(v)) return;
+    const int a = atoms.atom_at(v);
+    const int s = last[std::size_t(a)];
+    if (charged[std::size_t(a)] || s <= 0 || !state.test(a) || !problem.atoms[std::size_t(a)].must_in) return;
+    const int primitive = plan.steps[std::size_t(s)].primitive;
+    const PrimitiveSpec& prim = problem.primitives[std::size_t(primitive)];
+    if (prim.raw_stock || prim.mode != Mode::Additive || removal_after(s)) return;
+    charged[std::size_t(a)] = 1;
+    out.push_back({primitive, a, atom_volume(atoms, a)});
+  });
+  return out;
+}
+
+std::vector<Shortfall> find_skipped_layer_shortfalls(const PlanningProblem& problem, const AtomDecomposition& atoms,
+                                                     const Plan& plan, std::size_t steps, const geometry::Solid& built,
+                                                     const std::vector<RejectionReason>& reasons) {
+  const std::size_t executed = std::min(steps, plan.steps.size());
+  if (executed < 2) return {};  // never the first action (find_shortfalls)
+  const int n = atoms.atom_count();
+  const auto [state, last] = planned_state(problem, n, plan, executed);
+  const int step = int(executed) - 1;
+  const int primitive = plan.steps[std::size_t(step)].primitive;
+  const PrimitiveSpec& prim = problem.primitives[std::size_t(primitive)];
+  if (prim.mode != Mode::Additive || prim.raw_stock) return {};
+  const geometry::Lattice& lattice = atoms.lattice();
+  std::vector<Shortfall> out;
+  for (const RejectionReason& reason : reasons) {
+    if (reason.kind != "layer_skipped" || reason.action != int(executed) || !reason.where) continue;
+    const Index3 at{int(std::floor((reason.where->x - lattice.origin.x) / lattice.voxel_size)),
+                    int(std::floor((reason.where->y - lattice.origin.y) / lattice.voxel_size)),
+                    int(std::floor((reason.where->z - lattice.origin.z) / lattice.voxel_size))};
+    for (int dz = -2; dz <= 2; ++dz)
+      for (int dy = -2; dy <= 2; ++dy)
+        for (int dx = -2; dx <= 2; ++dx) {
+          const Index3 v{at.x + dx, at.y + dy, at.z + dz};
+          if (!atoms.domain().contains(v) || built.contains(v)) continue;
+          const int a = atoms.atom_at(v);
+          if (last[std::size_t(a)] != step || !problem.atoms[std::size_t(a)].must_in || !state.test(a)) continue;
+          if (std::none_of(out.begin(), out.end(), [a](const Shortfall& s) { return s.atom == a; }))
+            out.push_back({primitive, a, atom_volume(atoms, a)});
+        }
   }
   return out;
 }

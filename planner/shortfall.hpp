@@ -50,4 +50,24 @@ struct CandidateCheck {
 std::vector<Shortfall> find_shortfalls(const PlanningProblem& problem, const AtomDecomposition& atoms, const Plan& plan,
                                        std::size_t steps, const geometry::Solid& built);
 
+// A plan whose additions are done with part of the design's core missing (validation's
+// "missing_material": removals cannot put it back) often misses it by a strip along an edge,
+// a bead's inset, which is a small part of each atom it touches and made by an action
+// before the last. `missing`: the core voxels absent from the material (on the atoms'
+// lattice). Each atom holding one is charged to the action that deposited it last in the
+// plan, when no removal follows that action (additions never take material away, so what
+// is missing is that deposit's) and it is not the first action nor raw stock.
+std::vector<Shortfall> find_missing_core_shortfalls(const PlanningProblem& problem, const AtomDecomposition& atoms,
+                                                    const Plan& plan, std::size_t steps, const geometry::Solid& missing);
+
+// A layer the last executed action skipped (a "layer_skipped" reason: material over it the
+// head cannot reach past, which may be a bead an earlier deposit spilled, not in the plan's
+// state) leaves a few voxels of a large atom missing, far less than find_shortfalls' half.
+// The toolpath has said where, so the atoms missing voxels within two voxels of that point,
+// which that action is the one to deposit in the plan, are charged to its primitive: with
+// them taken out, the search stops offering the same deposit to fill the same spot.
+std::vector<Shortfall> find_skipped_layer_shortfalls(const PlanningProblem& problem, const AtomDecomposition& atoms,
+                                                     const Plan& plan, std::size_t steps, const geometry::Solid& built,
+                                                     const std::vector<RejectionReason>& reasons);
+
 }  // namespace hybridctl::planner

@@ -201,8 +201,9 @@ class DepositionBuilder {
   DepositionBuilder(const config::AdditiveHead& head, const DepositionOptions& options, Toolpath& path)
       : head_(head), options_(options), path_(path) {}
 
-  // The layers of `roi_all` less `existing` (both work frame, one lattice).
-  void run(const Solid& roi_all, const Solid& existing);
+  // The layers of `roi_all` less `existing` (both work frame, one lattice); `counted`: the
+  // part of the ROI the plan counts on (DepositionOptions::counted_on, work frame) or null.
+  void run(const Solid& roi_all, const Solid& existing, const Solid* counted);
 
  private:
   double face(int k) const { return oz_ + k * h_; }  // bottom face of voxel layer k
@@ -210,7 +211,7 @@ class DepositionBuilder {
   void start_columns(const Solid& existing, const IndexBox& roi_box, const IndexBox& existing_box);
   void deposit_layer(int layer, double zb);
   // The ROI's voxel layers whose centres lie in the band [zb, zb + layer_height); `k` the highest.
-  SliceMask layer_region(double zb, int& k) const;
+  SliceMask layer_region(const Solid& solid, double zb, int& k) const;
   void drop_blocked(SliceMask& region, int k, int layer, double zb);
   void drop_overhangs(SliceMask& region, int layer, double zb);
   std::vector<Pass> passes_of(const SliceMask& region, const SliceMask& wall, int layer, double angle);
@@ -230,6 +231,7 @@ class DepositionBuilder {
   double h_ = 1, oz_ = 0;
   Solid roi_;
   Solid existing_;   // material present before the action
+  const Solid* counted_ = nullptr;  // DepositionOptions::counted_on in the work frame
   IndexBox window_;  // the columns: ROI and existing material, with room for the nozzle
   std::vector<int> existing_top_index_;
   ColumnMap existing_top_, deposited_top_, travel_top_;
@@ -241,11 +243,12 @@ class DepositionBuilder {
   // Emission state.
   bool started_ = false;
   Vec3 at_{};
-  int warnings_overhang_ = 0, dropped_total_ = 0;
-  double overhang_area_total_ = 0;
+  int warnings_overhang_ = 0, dropped_total_ = 0, warnings_uncounted_ = 0;
+  double overhang_area_total_ = 0, uncounted_area_total_ = 0;
 };
 
-void DepositionBuilder::run(const Solid& roi_all, const Solid& existing) {
+void DepositionBuilder::run(const Solid& roi_all, const Solid& existing, const Solid* counted) {
+  counted_ = counted;
   lattice_ = roi_all.lattice();
   h_ = lattice_.voxel_size;
   oz_ = lattice_.origin.z;
@@ -387,12 +390,12 @@ void DepositionBuilder::travel_to(Vec2 p, double z) {
 
 // Every ROI voxel belongs to exactly one layer. A band thinner than a voxel may hold no
 // centre: it takes the layer its middle lies in, so no layer of the build is skipped.
-SliceMask DepositionBuilder::layer_region(double zb, int& k) const {
+SliceMask DepositionBuilder::layer_region(const Solid& solid, double zb, int& k) const {
   int k_lo = int(std::ceil((zb - oz_) / h_ - 0.5 - 1e-9));
   int k_hi = int(std::ceil((zb + lh_ - oz_) / h_ - 0.5 - 1e-9)) - 1;
   if (k_hi < k_lo) k_lo = k_hi = int(std::floor((zb + lh_ / 2 - oz_) / h_));
-  SliceMask region = slice_of(roi_, k_lo, window_);
-  for (int kk = k_lo + 1; kk <= k_hi; ++kk) region |= slice_of(roi_, kk, window_);
+  SliceMask region = slice_of(solid, k_lo, window_);
+  for (int kk = k_lo + 1; kk <= k_hi; ++kk) region |= slice_of(solid, kk, window_);
   k = k_hi;
   return region;
 }
@@ -405,9 +408,22 @@ void DepositionBuilder::drop_blocked(SliceMask& region, int k, int layer, double
       if (region.at(x, y) &&
           existing_top_index_[std::size_t(y - window_.lo.y) * std::size_t(existing_top_.nx) + std::size_t(x - window_.lo.x)] > k)
         blocked.set(x, y);
+  if (blocked.empty()) return;
+  region = region.without(blocked);
+  if (counted_) {
+    int band_top = 0;
+    const SliceMask uncounted = blocked.without(layer_region(*counted_, zb, band_top));
+    if (!uncounted.empty()) {
+      const double area = double(uncounted.count()) * h_ * h_;
+      uncounted_area_total_ += area;
+      if (++warnings_uncounted_ <= kMaxWarningsPerKind)
+        path_.warnings.push_back("layer " + std::to_string(layer + 1) + " at z=" + mm(zb) + " mm: " + mm(area) +
+                                 " mm^2 that earlier actions were to lay lie under existing material; left out");
+      blocked = blocked.without(uncounted);
+    }
+  }
   const std::int64_t n = blocked.count();
   if (n == 0) return;
-  region = region.without(blocked);
   const double area = double(n) * h_ * h_;
   // The part would lack this deposit: a defect (export refuses, validation rejects).
   const CellBox b = cell_bounds(blocked);
@@ -465,7 +481,7 @@ std::vector<Pass> DepositionBuilder::passes_of(const SliceMask& region, const Sl
 
 void DepositionBuilder::deposit_layer(int layer, double zb) {
   int k = 0;
-  SliceMask region = layer_region(zb, k);
+  SliceMask region = layer_region(roi_, zb, k);
   if (region.empty()) return;
   drop_blocked(region, k, layer, zb);
   if (region.empty()) return;
@@ -504,6 +520,9 @@ void DepositionBuilder::finish() {
   if (warnings_overhang_ > kMaxWarningsPerKind)
     path_.warnings.push_back("overhang: " + std::to_string(warnings_overhang_) + " layers in all, " +
                              mm(overhang_area_total_) + " mm^2 with nothing below it, not deposited");
+  if (warnings_uncounted_ > kMaxWarningsPerKind)
+    path_.warnings.push_back("under existing material: " + std::to_string(warnings_uncounted_) + " layers in all, " +
+                             mm(uncounted_area_total_) + " mm^2 that earlier actions were to lay, left out");
   if (dropped_total_ > 0)
     path_.warnings.push_back(std::to_string(dropped_total_) + " raster segments shorter than " + mm(min_length_) +
                              " mm dropped (narrow parts of the region stay unfilled)");
@@ -524,9 +543,13 @@ Toolpath deposition_path(const Solid& roi_part, const Solid& existing_part, cons
   path.instrument = head.name;
   path.tool_number = instruments::head_tool_number(head, options.fallback_tool_number);
   path.setup = setup.name;
+  if (options.counted_on && !(options.counted_on->lattice() == roi_part.lattice()))
+    throw std::invalid_argument("deposition_path: the ROI and the part counted on are on different lattices");
   const Solid roi_all = part_to_work(roi_part, setup.approach);
   const Solid existing = has_existing ? part_to_work(existing_part, setup.approach) : Solid(roi_all.lattice(), {});
-  DepositionBuilder(head, options, path).run(roi_all, existing);
+  const std::optional<Solid> counted =
+      options.counted_on ? std::optional<Solid>(part_to_work(*options.counted_on, setup.approach)) : std::nullopt;
+  DepositionBuilder(head, options, path).run(roi_all, existing, counted ? &*counted : nullptr);
   return path;
 }
 

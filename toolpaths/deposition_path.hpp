@@ -66,6 +66,14 @@ struct DepositionOptions {
   // machine loader always sets it (default 100 + the head's index). Plan export passes
   // instruments::head_tool_number(machine, index), as the simulated machine numbers heads.
   int fallback_tool_number = 0;
+  // The voxels of the ROI the plan counts on this action for (part frame, the ROI's
+  // lattice), when the ROI also holds what earlier actions were meant to lay and did not:
+  // executed from the material really present, an action's ROI is its primitive less that
+  // material. Of those others, what lies under existing material is left out with a
+  // warning, not a defect: the plan never counted on this action for it, and what the part
+  // then lacks is judged where the part is judged (validation compares it with the
+  // design). Null: all of the ROI is counted on.
+  const geometry::Solid* counted_on = nullptr;
 };
 
 // The deposition toolpath of one additive action.
@@ -75,7 +83,7 @@ struct DepositionOptions {
 //   setup     the setup: its approach becomes the work frame's +Z; its name is recorded
 // Moves are in mm in the work frame. Defects (Toolpath::defects, the part will be wrong):
 // ROI under existing material, not reachable from the approach side, is skipped
-// ("layer_skipped", one per layer). Warnings: overhangs (region with nothing below: not laid),
+// ("layer_skipped", one per layer; a warning where the options do not count on it). Warnings: overhangs (region with nothing below: not laid),
 // dropped short segments. A layer height, hatch spacing or feed left at 0 takes the machine
 // file's default (0.8 x bead height, 0.7 x bead width, 1000 mm/min). Throws
 // std::invalid_argument on solids on different lattices or a head without a bead.

@@ -1,5 +1,6 @@
 #include "toolpaths/plan_export.hpp"
 
+#include <optional>
 #include <stdexcept>
 
 #include "common/error.hpp"
@@ -26,8 +27,10 @@ double plate_z(const planner::PlanFile& file, const geometry::IndexBox& simulate
 }
 
 // The action's toolpath from its region of influence in the material it meets.
+// `counted_on`: DepositionOptions::counted_on, or null.
 void make_program(const planner::PlanFile& file, const geometry::IndexBox& simulated, const planner::PlanFilePrimitive& p,
-                  const config::Machine& machine, const ExportOptions& options, ExportedAction& a) {
+                  const config::Machine& machine, const ExportOptions& options, ExportedAction& a,
+                  const geometry::Solid* counted_on) {
   const config::Setup& setup = setup_named(machine, p);
   ActionProgram& prog = a.program;
   prog.action = a.step;
@@ -49,6 +52,7 @@ void make_program(const planner::PlanFile& file, const geometry::IndexBox& simul
     DepositionOptions d = options.deposition;
     d.fallback_tool_number = instruments::head_tool_number(machine, index);
     if (!d.build_plate_z && !a.before.empty()) d.build_plate_z = plate_z(file, simulated, setup);
+    d.counted_on = counted_on;
     prog.path = deposition_path(a.roi, a.before, *head, setup, d);
   } else {
     const config::CuttingTool* tool = machine.find_tool(p.tool_number);
@@ -91,9 +95,12 @@ void check_machine(const planner::PlanFile& file, const config::Machine& machine
 
 // Action `k` of the plan, meeting `before`; `after` is the planned state after it, or
 // null when the material present is fed back (the action's primitive applied to `before`).
+// `planned_before`, with the material fed back: the plan's state before the action, which
+// tells the part of a deposit's ROI the plan counts on it for (DepositionOptions::counted_on).
 ExportedAction make_action(int k, geometry::Solid before, const geometry::Solid* after, const geometry::IndexBox& simulated,
                            const planner::PlanFile& file, const planner::PlanFilePlan& plan,
-                           const config::Machine& machine, const ExportOptions& options) {
+                           const config::Machine& machine, const ExportOptions& options,
+                           const geometry::Solid* planned_before = nullptr) {
   const planner::PlanFilePrimitive& p = file.primitives.at(std::size_t(plan.actions.at(std::size_t(k)).primitive));
   const bool additive = p.mode == planner::Mode::Additive;
   ExportedAction a;
@@ -110,7 +117,11 @@ ExportedAction make_action(int k, geometry::Solid before, const geometry::Solid*
     throw InputError(p.name + " is a primitive from the file " + p.capability +
                      ": no head or tool of the machine is known to make it; expected machine primitives only");
   } else {
-    make_program(file, simulated, p, machine, options, a);
+    // With the material fed back, the part of a deposit's ROI the plan counts on it for:
+    // what its primitive adds to the planned state before it.
+    const std::optional<geometry::Solid> counted_on =
+        additive && planned_before ? std::optional(subtract(a.roi, *planned_before)) : std::nullopt;
+    make_program(file, simulated, p, machine, options, a, counted_on ? &*counted_on : nullptr);
   }
   return a;
 }
@@ -126,8 +137,9 @@ void export_from(int first, geometry::Solid present, const std::vector<geometry:
     if (options.progress) options.progress(k + 1, n);
     const planner::PlanFilePrimitive& p = file.primitives[std::size_t(plan.actions[std::size_t(k)].primitive)];
     if (p.raw_stock()) out.raw_stock = p.label;
+    const geometry::Solid* planned_before = planned.empty() ? nullptr : &planned[std::size_t(k)];
     ExportedAction a = material_after
-                           ? make_action(k, present, nullptr, simulated, file, plan, machine, options)
+                           ? make_action(k, present, nullptr, simulated, file, plan, machine, options, planned_before)
                            : make_action(k, planned[std::size_t(k)], &planned[std::size_t(k) + 1], simulated, file, plan,
                                          machine, options);
     if (material_after) present = material_after(a);
@@ -160,7 +172,8 @@ PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePla
   }
   const int first = int(start.actions.size());
   out.actions = std::move(start.actions);
-  export_from(first, std::move(start.present), {}, file, plan, machine, options, material_after, out);
+  export_from(first, std::move(start.present), planner::plan_states(file, plan), file, plan, machine, options,
+              material_after, out);
   return out;
 }
 

@@ -9,6 +9,7 @@
 #include "gcode/check.hpp"
 #include "gcode/post.hpp"
 #include "planner/plan_report.hpp"
+#include "planner/start_stock.hpp"
 
 namespace hybridctl::validation {
 
@@ -65,6 +66,7 @@ PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions option
     std::vector<FailedPrefix> failed_prefixes;
     // ... and the same holds for the prefixes that went right: candidates go on from there.
     std::shared_ptr<PrefixCache> cache;
+    std::optional<geometry::Solid> core;  // the design's core (planner::spared_by_cuts), once
   };
   // A candidate is rejected at its first failing action: its first reasons are enough.
   options.run_until = RunUntil::FirstFailingAction;
@@ -103,6 +105,13 @@ PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions option
       if (run.proven()) return planner::CandidateCheck{};
       const std::size_t executed = run.stopped_after > 0 ? std::size_t(run.stopped_after) : plan.steps.size();
       std::vector<planner::Shortfall> shortfalls = planner::find_shortfalls(r.problem, r.atoms, plan, executed, run.as_built);
+      if (shortfalls.empty() && run.missing_after_last_addition) {
+        if (!state->core) state->core = planner::spared_by_cuts(*state->file);
+        shortfalls = planner::find_missing_core_shortfalls(r.problem, r.atoms, plan, executed,
+                                                           geometry::subtract(*state->core, run.as_built));
+      }
+      if (shortfalls.empty())
+        shortfalls = planner::find_skipped_layer_shortfalls(r.problem, r.atoms, plan, executed, run.as_built, run.reasons);
       return planner::CandidateCheck{std::move(run.reasons), std::move(shortfalls)};
     } catch (const InputError& e) {
       // The plan cannot be written for this machine (a move beyond its envelope, ...): it

@@ -183,6 +183,28 @@ TEST_F(Cli, TheOverhangOnTheBAxisMachineIsProvenImpossibleBeforeAnySearch) {
   EXPECT_NE(json.find("\"violations\": [\n"), std::string::npos);
 }
 
+// The slots on the B-axis machine: the model has plans (deposit from +Y, then the slots'
+// edges from the top and the sides), and execution shows the top deposit cannot lay the
+// 0.5 mm strips beside the slots (a bead's inset). Corrected by that, the proof finds no
+// plan, and the search is over; a correction is not a proof, so the word stays UNDECIDED.
+TEST_F(Cli, TheSlotsOnTheBAxisMachineHaveNoPlanLeftOnceExecutionHasCorrectedTheModel) {
+  const std::string machine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/multitask-b-axis.yaml";
+  const std::string part = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/slots.stl";
+  const Outcome r = run({"plan", part, "--machine", machine, "-o", (dir_ / "plan").string()});
+  EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
+  EXPECT_NE(r.out.find("verdict     UNDECIDED: no plan is left once the primitives are corrected by what execution "
+                       "showed (1 candidate rejected; executed candidates showed 1 primitive falling short"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("): on the corrected primitives, no sequence of the 64 primitives gets these"), std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("search stopped at its limit"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("x (((P13 \u222A P52) \u222A P56) \u222A P11)  cost 2.4386: missing_material: action 4"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("learned     executed candidates showed"), std::string::npos) << r.out;
+}
+
 TEST_F(Cli, PlansTheFlangedHubAndWritesPlanJsonWithValidPlans) {
   const Outcome r = run({"plan", "--no-validate", kFlangedHub, "--machine", kMachine, "--voxel", "1", "-o", (dir_ / "plan").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;

@@ -92,6 +92,41 @@ TEST(Shortfall, RawStockIsNeverCharged) {
   EXPECT_TRUE(find_shortfalls(row.problem, row.atoms, row.plan({2}), 1, Solid(kMm, kRow)).empty());
 }
 
+TEST(Shortfall, CoreMissingAfterTheAdditionsIsChargedToTheDepositThatLaidItsAtom) {
+  const Row row;
+  const Solid missing = Solid::filled(kMm, {{1, 0, 0}, {2, 1, 1}});  // one voxel of the middle atom
+  // Half of the middle atom built: too little to tell from the atom alone, but the core
+  // missing there is the deposit's, as nothing after it removes.
+  const Solid built = geometry::unite(voxels(0, 1), voxels(2, 4));
+  EXPECT_TRUE(find_shortfalls(row.problem, row.atoms, row.plan({2, 0}), 2, built).empty());
+  std::vector<Shortfall> found = find_missing_core_shortfalls(row.problem, row.atoms, row.plan({2, 0}), 2, missing);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0], (Shortfall{0, row.atom_at(1), 2.0}));
+  // A removal after the deposit may have taken it; the first action works on the plate.
+  EXPECT_TRUE(find_missing_core_shortfalls(row.problem, row.atoms, row.plan({2, 0, 1}), 3, missing).empty());
+  EXPECT_TRUE(find_missing_core_shortfalls(row.problem, row.atoms, row.plan({0}), 1, missing).empty());
+  // The stock's voxel missing: never charged (the deposit did not lay it, the stock did).
+  EXPECT_TRUE(find_missing_core_shortfalls(row.problem, row.atoms, row.plan({2, 0}), 2, voxels(0, 1)).empty());
+}
+
+TEST(Shortfall, ALayerTheLastActionSkippedChargesTheAtomsMissingWhereTheToolpathSaid) {
+  const Row row;
+  const Solid built = geometry::unite(voxels(0, 2), voxels(3, 4));  // voxel 2 not laid
+  const RejectionReason skipped{"layer_skipped", 2, 0, "layer 3 ... skipped", geometry::Vec3{2.5, 0.5, 0.5}};
+  std::vector<Shortfall> found =
+      find_skipped_layer_shortfalls(row.problem, row.atoms, row.plan({2, 0}), 2, built, {skipped});
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0], (Shortfall{0, row.atom_at(2), 2.0}));
+  // Another action's skip, another kind of reason, or nothing missing near it: nothing.
+  RejectionReason other = skipped;
+  other.action = 1;
+  EXPECT_TRUE(find_skipped_layer_shortfalls(row.problem, row.atoms, row.plan({2, 0}), 2, built, {other}).empty());
+  other = skipped;
+  other.kind = "gouge";
+  EXPECT_TRUE(find_skipped_layer_shortfalls(row.problem, row.atoms, row.plan({2, 0}), 2, built, {other}).empty());
+  EXPECT_TRUE(find_skipped_layer_shortfalls(row.problem, row.atoms, row.plan({2, 0}), 2, voxels(0, 4), {skipped}).empty());
+}
+
 // Planning with a validation that turns the first candidate down, reporting that its last
 // action did not do what the plan counts on for one atom: the search stops, the atom is
 // taken out of that primitive, and the next search offers only plans that do not count on

@@ -395,6 +395,27 @@ TEST(DepositionPath, RoiUnderExistingMaterialIsSkipped) {
     along(s.a, s.b, 0.05, [&](Vec3 q) { EXPECT_FALSE(q.x > 8.01 && q.x < 11.99) << q.x; });
 }
 
+TEST(DepositionPath, RoiUnderExistingMaterialThatThePlanDoesNotCountOnIsLeftOutWithAWarning) {
+  // The same bridge; the plan counts on this action for the ROI's left half only (the rest
+  // an earlier action was to lay). Executed from the material present, the ROI holds both.
+  const Solid existing = geometry::unite(box({{0, 0, 0}, {20, 10, 1}}), box({{8, 0, 4}, {12, 10, 5}}));
+  const Solid roi = box({{2, 2, 1}, {18, 8, 3}});
+  const Solid left = box({{2, 2, 1}, {7, 8, 3}});
+  DepositionOptions o;
+  o.counted_on = &left;
+  const Toolpath p = deposition_path(roi, existing, ded_head(), top_setup(), o);
+  EXPECT_TRUE(p.defects.empty()) << p.defects.front().message;
+  EXPECT_TRUE(has_warning(p, "earlier actions were to lay lie under existing material")) << "said, not hidden";
+  for (const auto& s : deposition_segments(p))
+    along(s.a, s.b, 0.05, [&](Vec3 q) { EXPECT_FALSE(q.x > 8.01 && q.x < 11.99) << q.x; });
+  // Counted on under the bridge: the defect stays.
+  const Solid middle = box({{7, 2, 1}, {13, 8, 3}});
+  o.counted_on = &middle;
+  const Toolpath counted = deposition_path(roi, existing, ded_head(), top_setup(), o);
+  ASSERT_FALSE(counted.defects.empty());
+  EXPECT_EQ(counted.defects.front().kind, "layer_skipped");
+}
+
 TEST(DepositionPath, OtherSetupsWorkInTheirWorkFrame) {
   // Deposit from below (approach -Z): in the part frame the layers grow downwards.
   const Solid existing = box({{0, 0, 5}, {10, 10, 8}});
