@@ -385,7 +385,13 @@ CoreProof prove_by_core(const PlanningProblem& p, const CoreProofLimits& limits)
       return proof;
     }
     Replay r = replay(p, sequence, core, limits.atoms_per_round);
-    if (r.goal && r.too_many_uses) return proof;
+    if (r.goal && r.too_many_uses) {
+      sequence.resize(r.steps);
+      for (const int i : sequence)
+        proof.reuse_needed = std::max(proof.reuse_needed, int(std::count(sequence.begin(), sequence.end(), i)));
+      proof.sequence = std::move(sequence);
+      return proof;
+    }
     if (r.goal) {
       proof.outcome = CoreProof::Outcome::Feasible;
       sequence.resize(r.steps);

@@ -42,8 +42,11 @@ struct CoreProof {
   // each joined it to refute a projected plan).
   std::vector<int> core;
   // Feasible: primitives, in order, that make the whole goal (each used at most max_uses
-  // times). Unknown: the limits were reached, or a projected plan's failure named no atom.
+  // times). Unknown: the limits were reached, or a projected plan's failure named no atom;
+  // or a replay made the goal using a primitive more than max_uses times: then `sequence`
+  // is that replay, and `reuse_needed` the most times it uses one primitive.
   std::vector<int> sequence;
+  int reuse_needed = 0;
   // Why atoms joined S: a replayed deposit out of the head's reach, a first layer with
   // nothing under it, or atoms wrong at the end of a replayed plan; how many for each.
   enum class Why { OutOfReach, NothingUnder, WrongAtTheEnd };

@@ -253,7 +253,10 @@ json plans_json(const PlanningResult& r) {
                      {"toolpath_minutes", toolpath_total(r, k)},
                      {"optimality", optimality(plan, search_rank(r, k))},
                      {"search_rank", search_rank(r, k) + 1},
-                     {"found_by", plan.exact ? "exact-search" : plan.built ? "built-step-by-step" : "weighted-search"},
+                     {"found_by", plan.exact      ? "exact-search"
+                                 : plan.built  ? "built-step-by-step"
+                                 : plan.replayed ? "proof-replay"
+                                                 : "weighted-search"},
                      {"toolpath_cost", k < r.toolpath_costs.size() ? json(r.toolpath_costs[k]) : json(nullptr)},
                      {"gap", std::isfinite(plan.gap) ? json(plan.gap) : json(nullptr)},
                      {"file", "plans/plan-" + std::to_string(k + 1) + ".vdb"},
@@ -460,10 +463,16 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
     os << "plans       " << r.plans.size() << " (A*: " << r.search.expanded << " states expanded in "
        << fixed(r.search.seconds, 2) << " s";
     const bool built = std::any_of(r.plans.begin(), r.plans.end(), [](const Plan& p) { return p.built; });
-    if (r.search.weight > 1 || built) {
+    const bool replayed = std::any_of(r.plans.begin(), r.plans.end(), [](const Plan& p) { return p.replayed; });
+    if (r.search.weight > 1 || built || replayed) {
       os << "; the exact search hit its limit, so plans it did not prove come from ";
-      if (r.search.weight > 1) os << "weighted A* (w = " << r.search.weight << ")" << (built ? " and " : "");
-      if (built) os << "plans built step by step (deposit the missing design, then mill what lies outside it)";
+      std::vector<std::string> sources;
+      std::ostringstream weight;
+      weight << r.search.weight;
+      if (r.search.weight > 1) sources.push_back("weighted A* (w = " + weight.str() + ")");
+      if (replayed) sources.push_back("the proof's replay (a plan it found checking that one exists)");
+      if (built) sources.push_back("plans built step by step (deposit the missing design, then mill what lies outside it)");
+      for (std::size_t i = 0; i < sources.size(); ++i) os << (i ? " and " : "") << sources[i];
       os << " with a proven gap against the lower bound " << fixed(r.search.lower_bound, 4);
     }
     os << ")\n";

@@ -406,6 +406,7 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
   search.accept = accept_hook(options, r, validation_seconds, learning);
   search.known_to_fail = known_failure_hook(options, r);
   search.max_rejected = options.max_rejected;
+  if (r.core_proof.outcome == CoreProof::Outcome::Feasible) search.seeds.push_back(r.core_proof.sequence);
   // A rejection that showed a primitive falling short stops the search: the next one runs
   // on the problem without what the primitive does not do (planner/shortfall.hpp).
   if (options.learn)
@@ -484,6 +485,14 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
                        "nearest " + nearest_text(r, reach);
   }
   progress("search", 1);
+  const CoreProof& proof = r.core_proof;
+  if (r.plans.empty() && !r.verdict.decided_without_search && proof.reuse_needed > r.problem.max_uses) {
+    std::string sequence;
+    for (const int i : proof.sequence) sequence += (sequence.empty() ? "" : ", ") + r.problem.primitives[std::size_t(i)].name;
+    undecided_hint += "; the proof before the search found a sequence that makes the design using a primitive " +
+                      std::to_string(proof.reuse_needed) + " times (" + sequence + "): --reuse " +
+                      std::to_string(proof.reuse_needed) + " lets the search take it";
+  }
   if (r.plans.empty() && !r.verdict.decided_without_search && !r.learned.empty())
     undecided_hint += "; " + learned_text(r) + ", which may also rule out plans that would work";
   if (r.plans.empty() && !r.verdict.decided_without_search) {

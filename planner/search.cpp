@@ -247,8 +247,8 @@ void fill_with_weighted(const SearchOptions& options, const Make& make, Clock::t
 // turned down, few enough that building them stays cheap.
 constexpr std::size_t kGreedyCandidates = 24;
 
-// Plans built step by step (planner/search_greedy.hpp), cheapest first, judged as the
-// search's are: those accepted take free slots after the exact plans.
+// The seeds, then plans built step by step (planner/search_greedy.hpp), cheapest first,
+// judged as the search's are: those accepted take free slots after the exact plans.
 void fill_with_greedy(const PlanningProblem& p, const SearchOptions& options, std::vector<Plan>& plans,
                       SearchStats& st) {
   const int slots = options.top_k - int(plans.size());
@@ -257,14 +257,18 @@ void fill_with_greedy(const PlanningProblem& p, const SearchOptions& options, st
   for (const Plan& plan : plans) known.insert(sequence_of(plan));
   GoalFilter goals(p, options, known, st);
   int taken = 0;
-  for (const std::vector<int>& sequence : greedy_sequences(p, kGreedyCandidates)) {
+  std::vector<std::vector<int>> sequences = options.seeds;
+  const std::size_t seeds = sequences.size();
+  for (std::vector<int>& sequence : greedy_sequences(p, kGreedyCandidates)) sequences.push_back(std::move(sequence));
+  for (std::size_t k = 0; k < sequences.size(); ++k) {
     if (taken >= slots || st.rejected >= options.max_rejected) break;
     Plan plan;
-    if (!simulate(p, sequence, plan)) continue;
+    if (!simulate(p, sequences[k], plan)) continue;
     const GoalFilter::Verdict verdict = goals.judge(plan);
     if (verdict == GoalFilter::Take) {
       plan.exact = false;
-      plan.built = true;
+      plan.built = k >= seeds;
+      plan.replayed = k < seeds;
       plans.push_back(std::move(plan));
       ++taken;
     }

@@ -94,6 +94,7 @@ struct Plan {
   double gap = 0;
   bool exact = true;  // proven to be the rank-th cheapest accepted plan
   bool built = false;  // built step by step (planner/search_greedy.hpp), not found by a search
+  bool replayed = false;  // the proof's replay (SearchOptions::seeds), not found by a search
 };
 
 struct SearchStats {
@@ -166,6 +167,10 @@ struct SearchOptions {
   // same costs; false searches the problem as given, for comparison.
   bool reduce = true;
   SearchDirection direction = SearchDirection::Auto;
+  // Sequences found elsewhere that reach the goal (the proof from a few atoms replays one,
+  // planner/core_proof.hpp): when the exact search stops at a limit, judged before the
+  // plans built step by step, as they are.
+  std::vector<std::vector<int>> seeds;
 };
 
 // The k cheapest distinct accepted plans, cheapest first, by A* with the admissible and

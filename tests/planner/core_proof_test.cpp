@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 #include <random>
 
@@ -72,6 +73,34 @@ TEST(CoreProof, WhenTheRoofDoesNotBlockTheFloorTheReplayedPlanMakesThePart) {
   ASSERT_TRUE(detail::simulate(channel.p, proof.sequence, plan));
   EXPECT_TRUE(is_goal(channel.p, plan.final_state));
   EXPECT_EQ(expression(channel.p, plan), "(roof \u222A floor)");
+}
+
+// A floor F and a roof R laid together, the roof on a filler C that only a deposit with a
+// stud S lays, and the only way to clear C takes the floor with it: whatever the order,
+// the floor is laid twice. With each primitive allowed once the proof cannot call that a
+// plan, and says how many uses it needs.
+TEST(CoreProof, AReplayThatNeedsAPrimitiveTwiceIsNoPlanButSaysHowManyUsesItNeeds) {
+  enum { F, R, S, C, Atoms };
+  PlanningProblem p;
+  p.atoms = {{100, true, false}, {20, true, false}, {10, true, false}, {30, false, true}};
+  p.max_uses = 1;
+  p.primitives = {primitive("fill", Mode::Additive, Atoms, {C, S}), primitive("lay", Mode::Additive, Atoms, {F, R}),
+                  primitive("cut", Mode::Subtractive, Atoms, {F, C})};
+  auto footing = std::make_shared<DepositFooting>();
+  footing->kind = {DepositFooting::OnPlate, DepositFooting::NeedsCarrier, DepositFooting::None, DepositFooting::None};
+  footing->carriers = relation(Atoms, {R}, {C});
+  p.primitives[1].footing = footing;
+  CoreProof proof = prove_by_core(p);
+  EXPECT_EQ(proof.outcome, CoreProof::Outcome::Unknown);
+  EXPECT_EQ(proof.reuse_needed, 2);
+  EXPECT_EQ(std::count(proof.sequence.begin(), proof.sequence.end(), 1), 2);
+  p.max_uses = 2;
+  proof = prove_by_core(p);
+  ASSERT_EQ(proof.outcome, CoreProof::Outcome::Feasible);
+  EXPECT_EQ(proof.reuse_needed, 0);
+  Plan plan;
+  ASSERT_TRUE(detail::simulate(p, proof.sequence, plan));
+  EXPECT_TRUE(is_goal(p, plan.final_state));
 }
 
 // The roof R rests on either of C1 and C2, and the head cannot reach it past C1, which must

@@ -119,5 +119,34 @@ TEST(Search, WhenTheExactSearchStopsAtItsLimitPlansBuiltStepByStepAreOfferedWith
   EXPECT_TRUE(plans.front().built);
 }
 
+// A sequence found elsewhere (the proof's replay, planner/core_proof.hpp) is judged with
+// the plans built step by step, and comes first among them.
+TEST(Search, WhenTheExactSearchStopsAtItsLimitASeedIsOfferedWithItsGap) {
+  const VoxelProblem vp = block_and_cutters();
+  SearchOptions options{2};
+  options.max_expansions = 1;
+  options.direction = SearchDirection::Forward;
+  options.seeds = {{0, 4}};  // the block, milled by the finisher
+  std::vector<std::vector<int>> offered;
+  options.accept = [&](const Plan& plan) {
+    std::vector<int> sequence;
+    for (const PlanStep& s : plan.steps) sequence.push_back(s.primitive);
+    offered.push_back(sequence);
+    return true;
+  };
+  SearchStats stats;
+  const auto plans = find_plans(vp.problem, options, &stats);
+  ASSERT_EQ(plans.size(), 2u);
+  ASSERT_FALSE(offered.empty());
+  EXPECT_EQ(offered.front(), (std::vector<int>{0, 4}));
+  const auto seeded = std::find_if(plans.begin(), plans.end(), [](const Plan& p) { return p.replayed; });
+  ASSERT_NE(seeded, plans.end());
+  EXPECT_FALSE(seeded->exact);
+  EXPECT_FALSE(seeded->built);
+  EXPECT_EQ(expression(vp.problem, *seeded), "(block \u2212 finisher)");
+  EXPECT_TRUE(std::isfinite(seeded->gap));
+  EXPECT_EQ(testing::evaluate(vp, *seeded), vp.design);
+}
+
 }  // namespace
 }  // namespace hybridctl::planner
