@@ -41,7 +41,8 @@ struct DryRunArgs {
   std::string part, machine, output = "out/dry-run", transport = "modbus";
   int plan = 1;
   bool all = false;
-  double voxel = 0;
+  double voxel = 0, tolerance = -1;
+  int reuse = 1;
   std::string memory_budget;
   std::vector<std::string> stock_files;
   std::string objective;
@@ -203,6 +204,8 @@ int run_dry_run(const DryRunArgs& a) {
   // 1. Plan: every plan offered is proven by execution first (validation/).
   planner::PlanningOptions options;
   options.voxel_size = a.voxel;
+  options.tolerance = a.tolerance;
+  options.max_uses = a.reuse;
   options.memory_budget = memory_budget(a.memory_budget);
   validation::use_validation(options, machine);
   options.stock_files = a.stock_files;
@@ -254,6 +257,11 @@ void add_dry_run_command(CLI::App& app, Runner& runner) {
   cmd->add_flag("--all", a->all, "Run every offered plan, each on its own simulated controller from the raw stock")
       ->excludes(plan);
   cmd->add_option("--voxel", a->voxel, "Voxel size in mm (default: the machine file's)")->check(greater_than(0));
+  cmd->add_option("--tolerance", a->tolerance, "Tolerance in mm, as for `plan` (default: the machine file's planning.tolerance)")
+      ->check(at_least(0));
+  cmd->add_option("--reuse", a->reuse, "How often one primitive may appear in a plan, as for `plan`")
+      ->default_val(1)
+      ->check(between(1, 8));
   add_memory_budget_option(cmd, a->memory_budget);
   cmd->add_flag("--report", a->report,
                 "Also write the job report with what the run built and its alarms, DIR/report.html and its PNG snapshots");

@@ -249,6 +249,22 @@ TEST_F(Cli, EveryPlanOfTheArchChannelBlockMillsToTheChannelFloorAndRunsWithinTol
   EXPECT_EQ(plans, 5u) << r.out;
 }
 
+// dry-run plans as `plan` does, with its tolerance and reuse: the tolerance asked for is
+// the one planned with and the one the part as built is judged against.
+TEST_F(Cli, DryRunPlansAndJudgesWithTheToleranceAskedFor) {
+  const std::string fins = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/fins.stl";
+  const Outcome r = run({"dry-run", fins, "--machine", kMachine, "--tolerance", "0.25", "--reuse", "2", "-o",
+                         (dir_ / "dry").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("), tolerance 0.25 mm\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("within tolerance (0.25 mm)"), std::string::npos) << r.out;
+  const std::string json = slurp(dir_ / "dry" / "plan" / "plan.json");
+  EXPECT_NE(json.find("\"max_uses\": 2"), std::string::npos);
+  EXPECT_NE(json.find("\"tolerance\": 0.25"), std::string::npos);
+  EXPECT_EQ(run({"dry-run", fins, "--machine", kMachine, "--tolerance", "-1"}).exit_code, 2);
+  EXPECT_EQ(run({"dry-run", fins, "--machine", kMachine, "--reuse", "0"}).exit_code, 2);
+}
+
 // A repair (issue 16): the worn copy of the flanged hub (2.5 mm gone from half of the
 // flange's top) given as the stock. Every plan starts from it and deposits only what it
 // lacks; one deposits the neighbourhood of the missing region with overfill and mills the
