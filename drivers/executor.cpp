@@ -133,6 +133,15 @@ void open_journal(const JobRequest& request, Job& job, std::uint64_t identity) {
   job.journal = Journal::create(dir, job.header);
 }
 
+// The lines the controller executes: the program's, without the tape markers ("%") and
+// blank lines it may end with, which carry no block (a program posted for LinuxCNC ends
+// in "%" after its M30; the status never reports that line executed).
+std::size_t executable_lines(const std::vector<std::string>& lines) {
+  std::size_t n = lines.size();
+  while (n > 0 && lines[n - 1].find_first_not_of(" \t\r%") == std::string::npos) --n;
+  return n;
+}
+
 // Per action of the program: when its first and last lines were seen executed (host
 // clock, from the status), and the alarms raised while it ran. An action's lines run from
 // its heading to the next action's; the last action's to the program's end (the end
@@ -144,7 +153,7 @@ class ActionTracker {
     for (std::size_t i = 0; i < table.size(); ++i) {
       Span s;
       s.first = table[i].first_line;
-      s.last = i + 1 < table.size() ? table[i + 1].first_line - 1 : std::uint32_t(program.lines.size());
+      s.last = i + 1 < table.size() ? table[i + 1].first_line - 1 : std::uint32_t(executable_lines(program.lines));
       s.name = table[i].heading();
       s.number = table[i].number;
       spans_.push_back(std::move(s));
@@ -236,8 +245,8 @@ StreamCallbacks stream_callbacks(JobOperator& op, ActionTracker& actions, const 
     p.action = actions.current(s);
     p.actions = actions.size();
     p.action_number = actions.number(p.action);
-    p.lines = lines.size();
-    p.done = lines.empty() ? 1 : double(s.last_executed_line) / double(lines.size());
+    p.lines = executable_lines(lines);
+    p.done = p.lines == 0 ? 1 : std::min(1.0, double(s.last_executed_line) / double(p.lines));
     p.eta_s = p.done > 0.01 ? seconds_between(begun, now) * (1 - p.done) / p.done : 0;
     op.progress(s, p);
   };
@@ -268,7 +277,7 @@ JobResult stream_job(Job& job, JobOperator& op, double wait_for_controller_s) {
   result.stream = stream_program(*transport, job.program.lines, options, cb, &*job.journal);
   result.seconds = seconds_between(begun, Clock::now());
   result.transport = transport->counters();
-  result.lines = job.program.lines.size();
+  result.lines = executable_lines(job.program.lines);
   if (!result.stream.completed) actions.alarm(result.stream.final_status);
   result.actions = actions.report(result.stream.final_status.last_executed_line, Clock::now());
   result.alarms = actions.raised();

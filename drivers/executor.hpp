@@ -73,7 +73,7 @@ struct JobProgress {
 /// What the final report says of one action.
 struct ActionReport {
   std::string name;                  ///< its heading: "action 2: primitive P7, subtractive milling with ..."
-  std::uint32_t lines = 0;           ///< its lines: from its heading to the next action's (the last: to the end)
+  std::uint32_t lines = 0;           ///< its lines: from its heading to the next action's (the last: to the end, a closing "%" left out)
   std::uint32_t executed = 0;        ///< of them
   std::optional<double> seconds;     ///< from its first executed line to its last (or the end), as the host saw the status
   std::vector<std::pair<std::string, int>> alarms;  ///< each alarm once, in the order first raised, with how often
@@ -82,7 +82,7 @@ struct ActionReport {
 struct JobResult {
   StreamResult stream;
   TransportCounters transport;
-  std::size_t lines = 0;
+  std::size_t lines = 0;  ///< the lines the controller executes (a closing "%" left out)
   double seconds = 0;  ///< streaming time
   std::vector<ActionReport> actions;
   std::vector<std::pair<std::string, std::uint32_t>> alarms;  ///< every alarm raised, in order, with its line
