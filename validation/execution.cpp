@@ -157,6 +157,22 @@ int last_addition(const planner::PlanFile& file, const planner::PlanFilePlan& pl
   return 0;
 }
 
+// Where a set of voxels is, in one point: the centre of its voxel nearest to its centroid
+// (the first voxel would be a corner of the part whenever an edge is missing).
+std::optional<geometry::Vec3> central_voxel(const Solid& voxels) {
+  double n = 0, x = 0, y = 0, z = 0;
+  voxels.for_each_voxel([&](geometry::Index3 v) { n += 1, x += v.x, y += v.y, z += v.z; });
+  if (n == 0) return std::nullopt;
+  const double cx = x / n, cy = y / n, cz = z / n;
+  geometry::Index3 best{};
+  double nearest = -1;
+  voxels.for_each_voxel([&](geometry::Index3 v) {
+    const double d = (v.x - cx) * (v.x - cx) + (v.y - cy) * (v.y - cy) + (v.z - cz) * (v.z - cz);
+    if (nearest < 0 || d < nearest) nearest = d, best = v;
+  });
+  return voxels.lattice().center(best);
+}
+
 // The whole plan's program fed to the simulated machine action by action. After each
 // action the program of the actions made so far is posted and its lines up to the end of
 // the newest action's block are executed: the post-processor writes an action's block from
@@ -203,10 +219,7 @@ class IncrementalRun {
     const Solid& core = design_core();
     const Solid missing = subtract(core, on_domain(executor_.stock(), file_));
     if (missing.empty()) return;
-    std::optional<geometry::Vec3> where;
-    missing.for_each_voxel([&](geometry::Index3 v) {
-      if (!where) where = file_.lattice.center(v);
-    });
+    const std::optional<geometry::Vec3> where = central_voxel(missing);
     const int last = last_addition();
     const planner::PlanFilePrimitive& p = file_.primitives.at(std::size_t(plan_.actions.at(std::size_t(last - 1)).primitive));
     throw Stopped{step, planner::RejectionReason{

@@ -177,6 +177,10 @@ TEST(Execution, TheCoreMissingAfterTheLastAdditionStopsTheRunThere) {
   ASSERT_TRUE(r->where.has_value());
   const geometry::Vec3 at = *r->where;
   EXPECT_TRUE(at.x > 5 && at.x < 15 && at.y > 5 && at.y < 15 && at.z > 6 && at.z < 9) << "in the floating block";
+  // Its middle, not a corner: where the missing core is, as one point.
+  EXPECT_NEAR(at.x, 10, 1.01);
+  EXPECT_NEAR(at.y, 10, 1.01);
+  EXPECT_NEAR(at.z, 7.5, 1.01);
 
   const Execution whole = execute_plan(c.file, plan, machine());
   EXPECT_EQ(whole.stopped_after, 0);
