@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <tbb/parallel_for.h>
 #include <sstream>
 
 #include "common/number_text.hpp"
@@ -399,11 +400,20 @@ void write_plan_directory(const PlanningResult& r, const ReportSources& src, con
   try {
     fs::create_directories(staging / "primitives");
     fs::create_directories(staging / "plans");
-    geometry::write_vdb(r.design, staging / "design.vdb", "design");
-    for (const Primitive& p : r.primitives) geometry::write_vdb(p.region, staging / "primitives" / (p.name + ".vdb"), p.name);
-    for (std::size_t k = 0; k < r.plans.size(); ++k)
-      geometry::write_vdb(plan_outcome(r, r.plans[k]), staging / "plans" / ("plan-" + std::to_string(k + 1) + ".vdb"),
-                          "plan-" + std::to_string(k + 1));
+    // Tens of grids on the B-axis machine, each compressed on its own: written side by side.
+    const std::size_t grids = 1 + r.primitives.size() + r.plans.size();
+    tbb::parallel_for(std::size_t(0), grids, [&](std::size_t i) {
+      if (i == 0) {
+        geometry::write_vdb(r.design, staging / "design.vdb", "design");
+      } else if (i <= r.primitives.size()) {
+        const Primitive& p = r.primitives[i - 1];
+        geometry::write_vdb(p.region, staging / "primitives" / (p.name + ".vdb"), p.name);
+      } else {
+        const std::size_t k = i - 1 - r.primitives.size();
+        geometry::write_vdb(plan_outcome(r, r.plans[k]), staging / "plans" / ("plan-" + std::to_string(k + 1) + ".vdb"),
+                            "plan-" + std::to_string(k + 1));
+      }
+    });
     std::ofstream out(staging / "plan.json");
     out << plan_json(r, src, dir);
     if (!out.flush()) throw InputError((staging / "plan.json").string() + ": cannot write");
