@@ -32,16 +32,21 @@ std::vector<int> ids_of(const PlanningProblem& p, bool setups) {
 // Which primitives may still be used, and per atom the cheapest rate at which one of them
 // deposits (or removes) it, looked up when asked (usually the first in the list).
 struct LowerBound::Rates {
-  Rates(const LowerBound& b, std::vector<bool> usable) : bound(b), allowed(std::move(usable)), rate(b.lists_.size()) {
+  Rates(const LowerBound& b, std::vector<bool> usable) : bound(b), allowed(std::move(usable)), rate(b.first_rate_) {
     // Per supplier list (cheapest first) the rate of its first allowed member: every share
-    // of the bound asks for these, per atom, many times over.
-    for (std::size_t l = 0; l < b.lists_.size(); ++l) {
-      rate[l] = kInfinity;
-      for (int i : b.lists_[l])
-        if (allowed[std::size_t(i)]) {
-          rate[l] = b.p_.primitives[std::size_t(i)].cost_per_mm3;
-          break;
-        }
+    // of the bound asks for these, per atom, many times over. Most primitives are allowed:
+    // only the lists a disallowed one leads are looked through again.
+    for (std::size_t i = 0; i < allowed.size(); ++i) {
+      if (allowed[i]) continue;
+      for (const int l : b.led_by_[i]) {
+        double& r = rate[std::size_t(l)];
+        r = kInfinity;
+        for (int j : b.lists_[std::size_t(l)])
+          if (allowed[std::size_t(j)]) {
+            r = b.p_.primitives[std::size_t(j)].cost_per_mm3;
+            break;
+          }
+      }
     }
   }
   const LowerBound& bound;
@@ -111,6 +116,12 @@ void LowerBound::index_lists() {
   };
   for (const auto& list : lists_)
     list_mask_.push_back(mask([&](int i) { return std::find(list.begin(), list.end(), i) != list.end(); }));
+  // Each list's rate with every primitive allowed, and the lists each primitive leads.
+  led_by_.assign(p.primitives.size(), {});
+  for (std::size_t l = 0; l < lists_.size(); ++l) {
+    first_rate_.push_back(lists_[l].empty() ? kInfinity : p.primitives[std::size_t(lists_[l].front())].cost_per_mm3);
+    if (!lists_[l].empty()) led_by_[std::size_t(lists_[l].front())].push_back(int(l));
+  }
   for (std::size_t t = 0; t < tool_id_.size(); ++t)  // ids are below the primitives' count
     tool_mask_.push_back(mask([&](int i) { return tool_id_[std::size_t(i)] == int(t); }));
   for (std::size_t t = 0; t < setup_id_.size(); ++t)

@@ -28,15 +28,6 @@ PlannedState planned_state(const PlanningProblem& problem, int n, const Plan& pl
   return out;
 }
 
-double atom_volume(const AtomDecomposition& atoms, int atom) {
-  std::int64_t voxels = 0;
-  const IndexBox& d = atoms.domain();
-  for (int z = d.lo.z; z < d.hi.z; ++z)
-    for (int y = d.lo.y; y < d.hi.y; ++y)
-      for (int x = 0; x < d.hi.x - d.lo.x; ++x) voxels += atoms.atom_at_unchecked(x, y, z) == atom;
-  return double(voxels) * std::pow(atoms.lattice().voxel_size, 3);
-}
-
 }  // namespace
 
 std::vector<Shortfall> find_shortfalls(const PlanningProblem& problem, const AtomDecomposition& atoms, const Plan& plan,
@@ -92,7 +83,7 @@ std::vector<Shortfall> find_missing_core_shortfalls(const PlanningProblem& probl
     const PrimitiveSpec& prim = problem.primitives[std::size_t(primitive)];
     if (prim.raw_stock || prim.mode != Mode::Additive || removal_after(s)) return;
     charged[std::size_t(a)] = 1;
-    out.push_back({primitive, a, atom_volume(atoms, a)});
+    out.push_back({primitive, a, problem.atoms[std::size_t(a)].volume});
   });
   return out;
 }
@@ -123,7 +114,7 @@ std::vector<Shortfall> find_skipped_layer_shortfalls(const PlanningProblem& prob
           const int a = atoms.atom_at(v);
           if (last[std::size_t(a)] != step || !problem.atoms[std::size_t(a)].must_in || !state.test(a)) continue;
           if (std::none_of(out.begin(), out.end(), [a](const Shortfall& s) { return s.atom == a; }))
-            out.push_back({primitive, a, atom_volume(atoms, a)});
+            out.push_back({primitive, a, problem.atoms[std::size_t(a)].volume});
         }
   }
   return out;

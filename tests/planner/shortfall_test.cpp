@@ -101,7 +101,7 @@ TEST(Shortfall, CoreMissingAfterTheAdditionsIsChargedToTheDepositThatLaidItsAtom
   EXPECT_TRUE(find_shortfalls(row.problem, row.atoms, row.plan({2, 0}), 2, built).empty());
   std::vector<Shortfall> found = find_missing_core_shortfalls(row.problem, row.atoms, row.plan({2, 0}), 2, missing);
   ASSERT_EQ(found.size(), 1u);
-  EXPECT_EQ(found[0], (Shortfall{0, row.atom_at(1), 2.0}));
+  EXPECT_EQ(found[0], (Shortfall{0, row.atom_at(1), row.problem.atoms[std::size_t(row.atom_at(1))].volume}));
   // A removal after the deposit may have taken it; the first action works on the plate.
   EXPECT_TRUE(find_missing_core_shortfalls(row.problem, row.atoms, row.plan({2, 0, 1}), 3, missing).empty());
   EXPECT_TRUE(find_missing_core_shortfalls(row.problem, row.atoms, row.plan({0}), 1, missing).empty());
@@ -116,7 +116,7 @@ TEST(Shortfall, ALayerTheLastActionSkippedChargesTheAtomsMissingWhereTheToolpath
   std::vector<Shortfall> found =
       find_skipped_layer_shortfalls(row.problem, row.atoms, row.plan({2, 0}), 2, built, {skipped});
   ASSERT_EQ(found.size(), 1u);
-  EXPECT_EQ(found[0], (Shortfall{0, row.atom_at(2), 2.0}));
+  EXPECT_EQ(found[0], (Shortfall{0, row.atom_at(2), row.problem.atoms[std::size_t(row.atom_at(2))].volume}));
   // Another action's skip, another kind of reason, or nothing missing near it: nothing.
   RejectionReason other = skipped;
   other.action = 1;
