@@ -437,8 +437,11 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
     }
     learning.pending.clear();
     // What execution showed may leave the corrected problem with no plan at all: the proof
-    // says so in a moment, where the next search would run to its limit.
-    CoreProof corrected = prove_by_core(r.problem);
+    // says so in a moment, where the next search would run to its limit. A quarter of the
+    // first proof's budget (about a second) per round, as a round may follow round.
+    CoreProofLimits quick;
+    quick.max_states = quick.max_states / 4;
+    CoreProof corrected = prove_by_core(r.problem, quick);
     if (corrected.outcome == CoreProof::Outcome::Proven) {
       r.plans.clear();
       r.core_proof = std::move(corrected);
