@@ -1,5 +1,6 @@
 #include "toolpaths/plan_export.hpp"
 
+#include <algorithm>
 #include <optional>
 #include <stdexcept>
 
@@ -172,8 +173,13 @@ PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePla
   }
   const int first = int(start.actions.size());
   out.actions = std::move(start.actions);
-  export_from(first, std::move(start.present), planner::plan_states(file, plan), file, plan, machine, options,
-              material_after, out);
+  // The planned states tell what the plan counts on a deposit for: none needed when only
+  // removals remain.
+  const bool deposits = std::any_of(plan.actions.begin() + first, plan.actions.end(), [&](const planner::PlanFileAction& a) {
+    return file.primitives.at(std::size_t(a.primitive)).mode == planner::Mode::Additive;
+  });
+  export_from(first, std::move(start.present), deposits ? planner::plan_states(file, plan) : std::vector<geometry::Solid>{},
+              file, plan, machine, options, material_after, out);
   return out;
 }
 

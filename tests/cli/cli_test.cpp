@@ -145,13 +145,14 @@ TEST_F(Cli, MachineCheckAcceptsTheExamplesAndPointsAtEveryProblem) {
 namespace {
 
 const std::string kMachine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/hybrid-3axis.yaml";
+const std::string kBAxisMachine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/multitask-b-axis.yaml";
+const std::string kParts = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/";
 
 // The B-axis machine's 66 primitives (issue 15): the bound that prices removals with the
 // design they cut proves the block milled to the bracket optimal, and the plan is executed
 // from the block before it is offered.
 TEST_F(Cli, TheBracketOnTheBAxisMachineIsMilledFromTheBlockProvenOptimalAndExecuted) {
-  const std::string machine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/multitask-b-axis.yaml";
-  const Outcome r = run({"plan", kBracket, "--machine", machine, "--top", "1", "-o", (dir_ / "plan").string()});
+  const Outcome r = run({"plan", kBracket, "--machine", kBAxisMachine, "--top", "1", "-o", (dir_ / "plan").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("proven optimal"), std::string::npos) << r.out;
   // The first action is the block (P2), not a deposit finished by milling.
@@ -169,9 +170,7 @@ TEST_F(Cli, TheBracketOnTheBAxisMachineIsMilledFromTheBlockProvenOptimalAndExecu
 // search could say whether they combine, and it never finished (UNDECIDED after 30 s).
 // The proof from a few atoms says before any search that they do not, and names them.
 TEST_F(Cli, TheOverhangOnTheBAxisMachineIsProvenImpossibleBeforeAnySearch) {
-  const std::string machine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/multitask-b-axis.yaml";
-  const std::string part = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/overhang.stl";
-  const Outcome r = run({"plan", part, "--machine", machine, "-o", (dir_ / "plan").string()});
+  const Outcome r = run({"plan", kParts + "overhang.stl", "--machine", kBAxisMachine, "-o", (dir_ / "plan").string()});
   EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
   EXPECT_NE(r.out.find("verdict     NOT manufacturable: no sequence of the 66 primitives gets these"), std::string::npos)
       << r.out;
@@ -188,9 +187,7 @@ TEST_F(Cli, TheOverhangOnTheBAxisMachineIsProvenImpossibleBeforeAnySearch) {
 // 0.5 mm strips beside the slots (a bead's inset). Corrected by that, the proof finds no
 // plan, and the search is over; a correction is not a proof, so the word stays UNDECIDED.
 TEST_F(Cli, TheSlotsOnTheBAxisMachineHaveNoPlanLeftOnceExecutionHasCorrectedTheModel) {
-  const std::string machine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/multitask-b-axis.yaml";
-  const std::string part = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/slots.stl";
-  const Outcome r = run({"plan", part, "--machine", machine, "-o", (dir_ / "plan").string()});
+  const Outcome r = run({"plan", kParts + "slots.stl", "--machine", kBAxisMachine, "-o", (dir_ / "plan").string()});
   EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
   EXPECT_NE(r.out.find("verdict     UNDECIDED: no plan is left once the primitives are corrected by what execution "
                        "showed (1 candidate rejected; executed candidates showed 1 primitive falling short"),
