@@ -431,6 +431,24 @@ void write_plan_directory(const PlanningResult& r, const ReportSources& src, con
   }
 }
 
+// Below a voxel the tolerance leaves no play (docs/plan-format.md, "Tolerance"): worth
+// saying when no plan came out, as a round bore milled on such a grid never matches it.
+std::string finer_than_voxel_note(const PlanningResult& r) {
+  double finer = r.lattice.voxel_size;
+  while (r.tolerance > 0 && finer > r.tolerance) finer /= 2;
+  auto text = [](double mm) {
+    std::ostringstream os;
+    os << mm;
+    return os.str();
+  };
+  const std::string h = text(r.lattice.voxel_size), t = text(r.tolerance);
+  return "note        the tolerance (" + t + " mm) is finer than a voxel (" + h + " mm): a voxel too many or too few is " +
+         h + " mm off, so only a part made voxel for voxel is within it, and a cutter's or a bead's voxels seldom "
+         "follow a round or sloping face that exactly; the verdict is for this grid: --tolerance " + h +
+         " (at least a voxel)" + (r.tolerance > 0 ? " or --voxel " + text(finer) + " (no larger than the tolerance)" : "") +
+         " gives such faces the one voxel of play they need (docs/plan-format.md, \"Tolerance\")\n";
+}
+
 std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
   std::ostringstream os;
   const geometry::IndexBox b = r.design.bounding_box();
@@ -469,6 +487,7 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
   for (std::size_t i = 0; i < shown; ++i) os << "  - " << r.verdict.violations[i].description << "\n";
   if (r.verdict.violations.size() > shown) os << "  ... and " << r.verdict.violations.size() - shown << " more in plan.json\n";
   if (r.validated) os << rejected_summary(r);
+  if (r.plans.empty() && r.tolerance < r.lattice.voxel_size) os << finer_than_voxel_note(r);
   if (!r.plans.empty()) {
     os << "plans       " << r.plans.size() << " (A*: " << r.search.expanded << " states expanded in "
        << fixed(r.search.seconds, 2) << " s";

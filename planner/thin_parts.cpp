@@ -35,12 +35,45 @@ DeepestFirst deepest_first(const Solid& region, const Solid& design, Side side, 
   return d;
 }
 
+// The primitives made to the design: those wholly inside it (deposits that lay only the
+// design) and those wholly outside it (removals that never cut it). Where several atoms
+// could keep a thin part or a gap, one of theirs is the choice a plan can honour without
+// a tool's or a bead's voxels fitting the surface exactly: on a round bore's edge the
+// voxels a cutter's sweep leaves are scattered, the ones beside them are clear.
+bool shares(const AtomSet& a, const AtomSet& b) {
+  const std::size_t n = std::min(a.words().size(), b.words().size());
+  for (std::size_t w = 0; w < n; ++w)
+    if (a.words()[w] & b.words()[w]) return true;
+  return false;
+}
+
+struct CleanPrimitives {
+  AtomSet inside, outside;
+};
+CleanPrimitives clean_primitives(int primitive_count, const std::vector<AtomMeasures>& m) {
+  AtomSet touches_design(primitive_count), touches_air(primitive_count);
+  for (const AtomMeasures& a : m) {
+    AtomSet& touched = a.voxels_in_design > 0 ? touches_design : touches_air;
+    AtomSet& also = a.voxels_in_design < a.voxels ? touches_air : touches_design;
+    for (std::size_t w = 0; w < std::min(a.code.words().size(), touched.words().size()); ++w) {
+      touched.words()[w] |= a.code.words()[w];
+      also.words()[w] |= a.code.words()[w];
+    }
+  }
+  CleanPrimitives c{AtomSet(primitive_count), AtomSet(primitive_count)};
+  for (int i = 0; i < primitive_count; ++i) {
+    c.inside.set(i, touches_design.test(i) && !touches_air.test(i));
+    c.outside.set(i, touches_air.test(i) && !touches_design.test(i));
+  }
+  return c;
+}
+
 // Makes every voxel of `region` lie within the ball of an atom that holds it (material)
 // or clears it (air), choosing atoms as planner/thin_parts.hpp says. `pending` tracks
 // the voxels of `region` no chosen voxel covers yet, to prefer a candidate that covers
 // many; atoms that were must-in (must-out) before cover too, which the scan finds.
 void cover(const AtomDecomposition& atoms, const Solid& design, const Solid& region, Side side, double tolerance,
-           std::vector<AtomMeasures>& m) {
+           const AtomSet& clean, std::vector<AtomMeasures>& m) {
   if (region.empty()) return;
   const double h = design.voxel_size();
   const std::vector<Index3> offsets = geometry::offsets_of(geometry::Ball{tolerance}, h);
@@ -70,9 +103,10 @@ void cover(const AtomDecomposition& atoms, const Solid& design, const Solid& reg
     }
     if (covered) continue;
     // Candidates lie on u's side. Rather a free atom than a sliver (not relied on),
-    // rather a sliver than making an atom violating; then the one covering the most
-    // pending voxels, then the deepest (the medial core).
-    std::tuple<int, int, float> best{-1, 0, 0};
+    // rather a sliver than making an atom violating; then one that a primitive made to
+    // the design can get right (`clean`); then the one covering the most pending voxels,
+    // then the deepest (the medial core).
+    std::tuple<int, bool, int, float> best{-1, false, 0, 0};
     Index3 chosen{};
     around(u, offsets, [&](Index3 v) {
       if (!domain.contains(v) || design.contains(v) != material) return;
@@ -80,7 +114,7 @@ void cover(const AtomDecomposition& atoms, const Solid& design, const Solid& reg
       const int tier = a.sliver ? 1 : (material ? clears(a) : holds(a)) ? 0 : 2;
       int gain = 0;
       around(v, sample, [&](Index3 w) { gain += pending.contains(w); });
-      const std::tuple<int, int, float> score{tier, gain, order.depth.squared(v)};
+      const std::tuple<int, bool, int, float> score{tier, shares(a.code, clean), gain, order.depth.squared(v)};
       if (score > best) {
         best = score;
         chosen = v;
@@ -102,8 +136,9 @@ void cover(const AtomDecomposition& atoms, const Solid& design, const Solid& reg
 void mark_thin_parts(const AtomDecomposition& atoms, const Solid& design, const ToleranceZone& zone,
                      std::vector<AtomMeasures>& measures) {
   if (zone.tolerance <= 0) return;
-  cover(atoms, design, zone.thin, Side::Material, zone.tolerance, measures);
-  cover(atoms, design, zone.narrow, Side::Air, zone.tolerance, measures);
+  const CleanPrimitives clean = clean_primitives(atoms.primitive_count(), measures);
+  cover(atoms, design, zone.thin, Side::Material, zone.tolerance, clean.inside, measures);
+  cover(atoms, design, zone.narrow, Side::Air, zone.tolerance, clean.outside, measures);
 }
 
 }  // namespace hybridctl::planner

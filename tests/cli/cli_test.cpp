@@ -177,6 +177,11 @@ TEST_F(Cli, TheOverhangOnTheBAxisMachineIsProvenImpossibleBeforeAnySearch) {
   EXPECT_NE(r.out.find("(must be made), in "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("(must be left empty), in "), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("rejected"), std::string::npos) << r.out;
+  // The machine file's 0.3 mm is below its 0.5 mm voxel: the verdict says it is for this grid.
+  EXPECT_NE(r.out.find("note        the tolerance (0.3 mm) is finer than a voxel (0.5 mm)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--tolerance 0.5 (at least a voxel) or --voxel 0.25 (no larger than the tolerance)"),
+            std::string::npos)
+      << r.out;
   const std::string json = slurp(dir_ / "plan" / "plan.json");
   EXPECT_NE(json.find("\"proof\": "), std::string::npos);
   EXPECT_NE(json.find("\"violations\": [\n"), std::string::npos);
@@ -323,9 +328,10 @@ TEST_F(Cli, APartTheMachineCannotMakeExitsWithFour) {
                                  "tools:\n  - {number: 1, type: flat, diameter: 6}\n"
                                  "setups:\n  - {name: top, approach: +Z}\n"
                                  "raw_stocks: []\n");
-  const Outcome r = run({"plan", kBracket, "--machine", machine.string(), "--voxel", "2"});
+  const Outcome r = run({"plan", kBracket, "--machine", machine.string(), "--voxel", "2", "--tolerance", "2"});
   EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
   EXPECT_NE(r.out.find("NOT manufacturable"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("finer than a voxel"), std::string::npos) << r.out;  // a tolerance of a voxel has play
 }
 
 TEST_F(Cli, PlanArgumentsAreChecked) {

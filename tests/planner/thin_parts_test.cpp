@@ -106,6 +106,40 @@ TEST(ThinParts, SharpEdgesStay) {
   EXPECT_NE(m[std::size_t(atoms.atom_at({8, 8, 8}))].atom_class, AtomClass::Free);
 }
 
+// A pocket's floor meets its walls in sharp concave edges: with a tolerance of one voxel
+// the air voxel in each edge lies farther than the tolerance from the air beyond the hull,
+// so an atom beside it must be cleared. A cutter that stays clear of the design leaves
+// the edge voxels themselves (a bull nose, or a round bore's scattered voxels); only one
+// that gouges the walls reaches them. The choice falls on an atom the clean cutter
+// removes, so milling the pocket with it is a goal, and within tolerance both ways.
+TEST(ThinParts, AGapIsKeptOpenByAnAtomACutterClearOfTheDesignRemoves) {
+  const Solid block = box({4, 4, 4}, {28, 28, 20}), pocket = box({10, 10, 12}, {22, 22, 20});
+  const Solid design = subtract(block, pocket);
+  Solid floor_edges = subtract(box({10, 10, 12}, {22, 22, 13}), box({11, 11, 12}, {21, 21, 13}));
+  const Solid clean = subtract(pocket, floor_edges), gouging = box({9, 9, 11}, {23, 23, 20});
+  AtomDecomposition atoms(kUnit, kDomain);
+  atoms.add_primitive(design);  // a deposit that lays the design
+  atoms.add_primitive(clean);
+  atoms.add_primitive(gouging);
+  atoms.add_primitive(subtract(box({3, 3, 3}, {29, 29, 21}), box({11, 11, 13}, {21, 21, 21})));  // an overfill: design and skin
+  const auto m = measure_atoms(atoms, design, make_tolerance_zone(design, 1.0), 0.0);
+  ASSERT_FALSE(has_violating(m));
+  int cleared = 0;
+  for (const AtomMeasures& a : m) {
+    if (!a.thin_gap) continue;
+    ++cleared;
+    EXPECT_TRUE(a.code.test(1)) << "an atom the clean cutter cannot remove was chosen, around " << a.centroid.x << ", "
+                                << a.centroid.y << ", " << a.centroid.z;
+  }
+  EXPECT_GT(cleared, 0);
+  const Solid milled = subtract(block, clean);
+  for (std::size_t a = 0; a < m.size(); ++a)
+    if (m[a].atom_class == AtomClass::MustOut)
+      EXPECT_TRUE(intersect(milled, atoms.atom_solid(int(a))).empty()) << "must-out atom " << a << " is left";
+  const Deviation d = measure_deviation(milled, design, kDomain, 1.0);
+  EXPECT_TRUE(d.within_tolerance) << "out " << d.worst_out << ", missing " << d.worst_missing;
+}
+
 // Random shapes (boxes, balls, fins and slots one to three voxels across) and random
 // primitives; tolerances below, at and above whole voxels, on two lattices. Every
 // outcome the classes allow is within tolerance both ways; where an atom is violating,
