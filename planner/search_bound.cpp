@@ -32,13 +32,17 @@ std::vector<int> ids_of(const PlanningProblem& p, bool setups) {
 // Which primitives may still be used, and per atom the cheapest rate at which one of them
 // deposits (or removes) it, looked up when asked (usually the first in the list).
 struct LowerBound::Rates {
-  Rates(const LowerBound& b, std::vector<bool> usable) : bound(b), allowed(std::move(usable)), rate(b.first_rate_) {
+  Rates(const LowerBound& b, std::vector<bool> usable) : bound(b), allowed(std::move(usable)) {
     // Per supplier list (cheapest first) the rate of its first allowed member: every share
     // of the bound asks for these, per atom, many times over. Most primitives are allowed:
     // only the lists a disallowed one leads are looked through again.
+    bool stock_allowed = false;
+    for (std::size_t i = 0; i < allowed.size(); ++i) stock_allowed = stock_allowed || (allowed[i] && b.p_.primitives[i].raw_stock);
+    const Leaders& leaders = b.leaders_[stock_allowed ? 0 : 1];
+    rate = leaders.rate;
     for (std::size_t i = 0; i < allowed.size(); ++i) {
       if (allowed[i]) continue;
-      for (const int l : b.led_by_[i]) {
+      for (const int l : leaders.led_by[i]) {
         double& r = rate[std::size_t(l)];
         r = kInfinity;
         for (int j : b.lists_[std::size_t(l)])
@@ -116,11 +120,18 @@ void LowerBound::index_lists() {
   };
   for (const auto& list : lists_)
     list_mask_.push_back(mask([&](int i) { return std::find(list.begin(), list.end(), i) != list.end(); }));
-  // Each list's rate with every primitive allowed, and the lists each primitive leads.
-  led_by_.assign(p.primitives.size(), {});
-  for (std::size_t l = 0; l < lists_.size(); ++l) {
-    first_rate_.push_back(lists_[l].empty() ? kInfinity : p.primitives[std::size_t(lists_[l].front())].cost_per_mm3);
-    if (!lists_[l].empty()) led_by_[std::size_t(lists_[l].front())].push_back(int(l));
+  // Each list's rate with every primitive allowed (and without the raw stocks), and the
+  // lists each primitive leads.
+  for (int without_stocks = 0; without_stocks < 2; ++without_stocks) {
+    Leaders& leaders = leaders_[without_stocks];
+    leaders.led_by.assign(p.primitives.size(), {});
+    for (std::size_t l = 0; l < lists_.size(); ++l) {
+      const auto first = std::find_if(lists_[l].begin(), lists_[l].end(), [&](int i) {
+        return !without_stocks || !p.primitives[std::size_t(i)].raw_stock;
+      });
+      leaders.rate.push_back(first == lists_[l].end() ? kInfinity : p.primitives[std::size_t(*first)].cost_per_mm3);
+      if (first != lists_[l].end()) leaders.led_by[std::size_t(*first)].push_back(int(l));
+    }
   }
   for (std::size_t t = 0; t < tool_id_.size(); ++t)  // ids are below the primitives' count
     tool_mask_.push_back(mask([&](int i) { return tool_id_[std::size_t(i)] == int(t); }));

@@ -78,8 +78,14 @@ class LowerBound {
   // atoms share one, and what the lists force is worked out once per list.
   std::vector<std::vector<int>> lists_;
   std::vector<int> adder_list_, remover_list_;
-  std::vector<double> first_rate_;         // per list: its first (cheapest) member's rate
-  std::vector<std::vector<int>> led_by_;  // per primitive: the lists it comes first in
+  // Per list the rate of its first (cheapest) member, and per primitive the lists it comes
+  // first in: [0] with every primitive allowed, [1] with the raw stocks left out, as they
+  // are after the first action (they cost nothing and lead most deposits' lists).
+  struct Leaders {
+    std::vector<double> rate;
+    std::vector<std::vector<int>> led_by;
+  };
+  Leaders leaders_[2];
   // Bit masks over the primitives: per list its members, per tool (setup) id its primitives.
   std::vector<std::vector<std::uint64_t>> list_mask_, tool_mask_, setup_mask_;
   // Per list with a wrong atom in `state` (must-in missing: adders; must-out present: removers).
