@@ -356,7 +356,8 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
                    {"weight", r.search.weight},
                    {"lower_bound", r.search.lower_bound},
                    {"seconds", r.search.seconds},
-                   {"rounds", r.search_rounds}};
+                   {"rounds", r.search_rounds},
+                   {"replays", r.replay_rounds}};
 
   const json plans = plans_json(r);
   doc["plans"] = plans;

@@ -25,6 +25,7 @@
 #include "planner/fine_graining.hpp"
 #include "planner/memory_estimate.hpp"
 #include "planner/repair_primitives.hpp"
+#include "planner/search_steps.hpp"
 
 namespace hybridctl::planner {
 namespace {
@@ -381,7 +382,9 @@ std::string learned_text(const PlanningResult& r) {
          (primitives.size() == 1 ? "" : "s") + " falling short of the model on " + std::to_string(r.learned.size()) +
          " atom" + (r.learned.size() == 1 ? "" : "s") + " (" + trimmed_number(volume, 1) + " mm\u00B3; largest " + where +
          ", by " + r.problem.primitives[std::size_t(largest->primitive)].name + "), taken out of them over " +
-         std::to_string(r.search_rounds) + (r.search_rounds == 1 ? " search" : " searches");
+         std::to_string(r.search_rounds) + (r.search_rounds == 1 ? " search" : " searches") +
+         (r.replay_rounds == 0 ? ""
+          : " and " + std::to_string(r.replay_rounds) + " replay" + (r.replay_rounds == 1 ? "" : "s") + " of the proof");
 }
 
 namespace {
@@ -391,6 +394,45 @@ std::string unreachable_text(const PlanningResult& r, const Reachability& reach)
          " states they reach (costs aside, each primitive any number of times) is within tolerance. The nearest " +
          nearest_text(r, reach) +
          ". Deposits cannot reach under material already there, and removals cannot spare design they pass through";
+}
+
+// Takes what execution showed out of the problem's primitives.
+void take_in(Learning& learning, PlanningResult& r) {
+  for (const Shortfall& s : learning.pending) {
+    AtomSet& short_of = r.problem.primitives[std::size_t(s.primitive)].falls_short;
+    if (short_of.words().empty()) short_of = AtomSet(int(r.problem.atoms.size()));
+    short_of.set(s.atom);
+    r.learned.push_back(s);
+  }
+  learning.pending.clear();
+}
+
+// What execution showed may leave the corrected problem with no plan at all: the proof says
+// so in a moment, where the next search would run to its limit. A quarter of the first
+// proof's budget (about a second) per round, as a round may follow round. When the proof
+// instead replays a plan of the corrected problem, that plan is executed before another
+// search: the search would most likely offer it first, and when it fails too, what it
+// showed corrects the problem again without a search (a tube on a plate on the B-axis
+// machine: one search instead of two). A replay that passes leads the next search's seeds.
+CoreProof correct_by_replays(SearchOptions& search, std::int64_t max_rejected, Learning& learning, PlanningResult& r) {
+  CoreProofLimits quick;
+  quick.max_states = quick.max_states / 4;
+  for (;;) {
+    CoreProof corrected = prove_by_core(r.problem, quick);
+    if (corrected.outcome != CoreProof::Outcome::Feasible) return corrected;
+    search.seeds = {corrected.sequence};
+    Plan replay;
+    if (!search.accept || !detail::simulate(r.problem, corrected.sequence, replay) || !is_goal(r.problem, replay.final_state) ||
+        std::int64_t(r.rejected.size()) >= max_rejected || r.search_rounds + r.replay_rounds >= kMaxLearningRounds)
+      return corrected;
+    const std::size_t rejected = r.rejected.size();
+    if (search.accept(replay) || learning.pending.empty()) {
+      if (r.rejected.size() > rejected) search.seeds.clear();  // failed, and showed nothing to learn
+      return corrected;
+    }
+    ++r.replay_rounds;
+    take_in(learning, r);
+  }
 }
 
 void search_plans(int top_k, const PlanningOptions& options, const Progress& progress, PlanningResult& r,
@@ -410,7 +452,9 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
   // A rejection that showed a primitive falling short stops the search: the next one runs
   // on the problem without what the primitive does not do (planner/shortfall.hpp).
   if (options.learn)
-    search.interrupt = [&learning, &r]() { return !learning.pending.empty() && r.search_rounds < kMaxLearningRounds; };
+    search.interrupt = [&learning, &r]() {
+      return !learning.pending.empty() && r.search_rounds + r.replay_rounds < kMaxLearningRounds;
+    };
   r.validated = bool(options.validate);
   const auto started = std::chrono::steady_clock::now();
   SearchStats total;
@@ -429,19 +473,8 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
     total.weight = round.weight;
     total.lower_bound = round.lower_bound;
     if (!round.interrupted) break;
-    for (const Shortfall& s : learning.pending) {
-      AtomSet& short_of = r.problem.primitives[std::size_t(s.primitive)].falls_short;
-      if (short_of.words().empty()) short_of = AtomSet(int(r.problem.atoms.size()));
-      short_of.set(s.atom);
-      r.learned.push_back(s);
-    }
-    learning.pending.clear();
-    // What execution showed may leave the corrected problem with no plan at all: the proof
-    // says so in a moment, where the next search would run to its limit. A quarter of the
-    // first proof's budget (about a second) per round, as a round may follow round.
-    CoreProofLimits quick;
-    quick.max_states = quick.max_states / 4;
-    CoreProof corrected = prove_by_core(r.problem, quick);
+    take_in(learning, r);
+    CoreProof corrected = correct_by_replays(search, options.max_rejected, learning, r);
     if (corrected.outcome == CoreProof::Outcome::Proven) {
       r.plans.clear();
       r.core_proof = std::move(corrected);
@@ -449,7 +482,7 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
       break;
     }
     // The rounds share the budgets: turned-down plans and seconds.
-    search.max_rejected = std::max<std::int64_t>(1, options.max_rejected - total.rejected);
+    search.max_rejected = std::max<std::int64_t>(1, options.max_rejected - std::int64_t(r.rejected.size()));
     if (options.search_time > 0)
       search.time_limit = std::max(
           0.05, options.search_time - std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());

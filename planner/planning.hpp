@@ -108,9 +108,11 @@ struct PlanningResult {
   std::vector<Deviation> deviations;  // one per plan: its outcome against the design
   std::vector<RejectedPlan> rejected;  // candidates validation turned down, in the order found
   // What execution showed the primitives do not do (taken out of `problem`'s primitives),
-  // in the order learned, and how many searches ran (1 + the restarts they caused).
+  // in the order learned, how many searches ran (1 + the restarts they caused), and how
+  // many corrections came from executing the proof's replay between searches.
   std::vector<Shortfall> learned;
   int search_rounds = 0;
+  int replay_rounds = 0;
   bool validated = false;              // the plans were validated (PlanningOptions::validate)
   SearchStats search;
   FineGraining fine_graining;  // what fine-graining added, and what it could not split

@@ -184,5 +184,49 @@ TEST(Shortfall, PlanningLearnsFromARejectionAndSearchesAgainWithoutIt) {
   EXPECT_NE(learned_text(result).find("falling short of the model on 1 atom"), std::string::npos) << learned_text(result);
 }
 
+// When the proof on the corrected problem replays a plan, that plan is executed before
+// another search runs: here validation turns the first two candidates down, each for one
+// atom. The second is the proof's replay, and what it showed corrects the problem again
+// without a search; the search after it offers a plan that passes.
+TEST(Shortfall, TheCorrectedProofsReplayIsExecutedBeforeAnotherSearch) {
+  const config::Machine machine = config::load_machine(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
+  const geometry::TriangleMesh part = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/flanged-hub.stl");
+  PlanningOptions options;
+  options.voxel_size = 1.0;
+  options.top_k = 1;
+  std::vector<std::vector<int>> offered;
+  int searches_when_offered[2] = {0, 0};
+  options.validate = [&](const PlanningResult& r, const Plan& plan) {
+    std::vector<int> sequence;
+    for (const PlanStep& s : plan.steps) sequence.push_back(s.primitive);
+    offered.push_back(sequence);
+    if (offered.size() > 2) return CandidateCheck{};
+    searches_when_offered[offered.size() - 1] = r.search_rounds;
+    const int last = plan.steps.back().primitive;
+    const PrimitiveSpec& prim = r.problem.primitives[std::size_t(last)];
+    const AtomSet region = step_region(r, plan, plan.steps.size() - 1);
+    Shortfall taught;
+    for (int a = 0; a < int(r.problem.atoms.size()); ++a) {
+      const AtomSpec& spec = r.problem.atoms[std::size_t(a)];
+      const bool needed = prim.mode == Mode::Additive ? spec.must_in : spec.must_out;
+      if (region.test(a) && needed && (taught.atom < 0 || spec.volume > r.problem.atoms[std::size_t(taught.atom)].volume))
+        taught = {last, a, spec.volume};
+    }
+    return CandidateCheck{{{"missing_material", 0, 0, "the atom is not there", std::nullopt}}, {taught}};
+  };
+  const PlanningResult result = plan_part(part, "flanged-hub.stl", machine, options);
+  ASSERT_EQ(result.rejected.size(), 2u);
+  ASSERT_EQ(result.learned.size(), 2u);
+  EXPECT_EQ(result.replay_rounds, 1);
+  EXPECT_EQ(searches_when_offered[0], 1);
+  EXPECT_EQ(searches_when_offered[1], 1);  // no second search before the replay
+  EXPECT_EQ(result.search_rounds, 2);
+  ASSERT_EQ(result.plans.size(), 1u);
+  for (std::size_t i = 0; i < offered.size(); ++i)
+    EXPECT_EQ(std::count(offered.begin(), offered.end(), offered[i]), 1) << i;
+  EXPECT_NE(learned_text(result).find("over 2 searches and 1 replay of the proof"), std::string::npos)
+      << learned_text(result);
+}
+
 }  // namespace
 }  // namespace hybridctl::planner
