@@ -371,7 +371,8 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
     learned.push_back({{"primitive", r.problem.primitives[std::size_t(s.primitive)].name},
                        {"atom", s.atom},
                        {"volume_mm3", s.volume},
-                       {"centroid", {m.centroid.x, m.centroid.y, m.centroid.z}}});
+                       {"centroid", {m.centroid.x, m.centroid.y, m.centroid.z}},
+                       {"kind", s.spill ? "spills_onto" : "falls_short"}});
   }
   doc["learned"] = learned;
   json timings = json::object();

@@ -292,7 +292,8 @@ std::function<bool(const Plan&)> accept_hook(const PlanningOptions& options, Pla
       return true;
     }
     for (const Shortfall& s : check.shortfalls) {
-      const AtomSet& known = r.problem.primitives[std::size_t(s.primitive)].falls_short;
+      const PrimitiveSpec& prim = r.problem.primitives[std::size_t(s.primitive)];
+      const AtomSet& known = s.spill ? prim.atoms : prim.falls_short;
       const bool learned = !known.words().empty() && known.test(s.atom);
       if (!learned && std::find(learning.pending.begin(), learning.pending.end(), s) == learning.pending.end())
         learning.pending.push_back(s);
@@ -364,25 +365,41 @@ std::string nearest_text(const PlanningResult& r, const Reachability& reach) {
 
 }  // namespace
 
-std::string learned_text(const PlanningResult& r) {
-  if (r.learned.empty()) return {};
+namespace {
+
+// "N primitives falling short of the model on M atoms (V mm³; largest ...)" for the
+// shortfalls, or the spills, learned.
+std::string learned_kind_text(const PlanningResult& r, bool spills) {
   std::set<int> primitives;
   double volume = 0;
-  const Shortfall* largest = &r.learned.front();
+  int atoms = 0;
+  const Shortfall* largest = nullptr;
   for (const Shortfall& s : r.learned) {
+    if (s.spill != spills) continue;
     primitives.insert(s.primitive);
     volume += s.volume;
-    if (s.volume > largest->volume) largest = &s;
+    ++atoms;
+    if (!largest || s.volume > largest->volume) largest = &s;
   }
+  if (!largest) return {};
   const AtomMeasures& m = r.measures[std::size_t(largest->atom)];
   char where[96];
   std::snprintf(where, sizeof where, "%.3g mm\u00B3 around (%.1f, %.1f, %.1f) mm", m.volume, m.centroid.x, m.centroid.y,
                 m.centroid.z);
-  return "executed candidates showed " + std::to_string(primitives.size()) + " primitive" +
-         (primitives.size() == 1 ? "" : "s") + " falling short of the model on " + std::to_string(r.learned.size()) +
-         " atom" + (r.learned.size() == 1 ? "" : "s") + " (" + trimmed_number(volume, 1) + " mm\u00B3; largest " + where +
-         ", by " + r.problem.primitives[std::size_t(largest->primitive)].name + "), taken out of them over " +
-         std::to_string(r.search_rounds) + (r.search_rounds == 1 ? " search" : " searches") +
+  return std::to_string(primitives.size()) + " primitive" + (primitives.size() == 1 ? "" : "s") +
+         (spills ? " spilling onto " : " falling short of the model on ") + std::to_string(atoms) + " atom" +
+         (atoms == 1 ? "" : "s") + (spills ? " outside them" : "") + " (" + trimmed_number(volume, 1) +
+         " mm\u00B3; largest " + where + ", by " + r.problem.primitives[std::size_t(largest->primitive)].name + ")";
+}
+
+}  // namespace
+
+std::string learned_text(const PlanningResult& r) {
+  if (r.learned.empty()) return {};
+  const std::string short_of = learned_kind_text(r, false), spilled = learned_kind_text(r, true);
+  const std::string how = short_of.empty() ? "added to them" : spilled.empty() ? "taken out of them" : "corrected";
+  return "executed candidates showed " + short_of + (short_of.empty() || spilled.empty() ? "" : " and ") + spilled +
+         ", " + how + " over " + std::to_string(r.search_rounds) + (r.search_rounds == 1 ? " search" : " searches") +
          (r.replay_rounds == 0 ? ""
           : " and " + std::to_string(r.replay_rounds) + " replay" + (r.replay_rounds == 1 ? "" : "s") + " of the proof");
 }
@@ -399,9 +416,13 @@ std::string unreachable_text(const PlanningResult& r, const Reachability& reach)
 // Takes what execution showed out of the problem's primitives.
 void take_in(Learning& learning, PlanningResult& r) {
   for (const Shortfall& s : learning.pending) {
-    AtomSet& short_of = r.problem.primitives[std::size_t(s.primitive)].falls_short;
-    if (short_of.words().empty()) short_of = AtomSet(int(r.problem.atoms.size()));
-    short_of.set(s.atom);
+    PrimitiveSpec& prim = r.problem.primitives[std::size_t(s.primitive)];
+    if (s.spill) {
+      prim.atoms.set(s.atom);  // it deposits there too, wherever the plan stands
+    } else {
+      if (prim.falls_short.words().empty()) prim.falls_short = AtomSet(int(r.problem.atoms.size()));
+      prim.falls_short.set(s.atom);
+    }
     r.learned.push_back(s);
   }
   learning.pending.clear();

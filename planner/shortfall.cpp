@@ -28,20 +28,31 @@ PlannedState planned_state(const PlanningProblem& problem, int n, const Plan& pl
   return out;
 }
 
+// Per atom: its voxels in the domain and those of them in `built`.
+struct AtomFill {
+  std::vector<std::int64_t> voxels, present;
+};
+
+AtomFill atom_fill(const AtomDecomposition& atoms, const geometry::Solid& built) {
+  const int n = atoms.atom_count();
+  AtomFill f{std::vector<std::int64_t>(std::size_t(n), 0), std::vector<std::int64_t>(std::size_t(n), 0)};
+  const IndexBox& d = atoms.domain();
+  for (int z = d.lo.z; z < d.hi.z; ++z)
+    for (int y = d.lo.y; y < d.hi.y; ++y)
+      for (int x = 0; x < d.hi.x - d.lo.x; ++x) ++f.voxels[std::size_t(atoms.atom_at_unchecked(x, y, z))];
+  built.for_each_voxel([&](Index3 v) {
+    if (d.contains(v)) ++f.present[std::size_t(atoms.atom_at(v))];
+  });
+  return f;
+}
+
 }  // namespace
 
 std::vector<Shortfall> find_shortfalls(const PlanningProblem& problem, const AtomDecomposition& atoms, const Plan& plan,
                                        std::size_t steps, const geometry::Solid& built) {
   const int n = atoms.atom_count();
   const auto [state, last] = planned_state(problem, n, plan, steps);
-  std::vector<std::int64_t> voxels(std::size_t(n), 0), present(std::size_t(n), 0);
-  const IndexBox& d = atoms.domain();
-  for (int z = d.lo.z; z < d.hi.z; ++z)
-    for (int y = d.lo.y; y < d.hi.y; ++y)
-      for (int x = 0; x < d.hi.x - d.lo.x; ++x) ++voxels[std::size_t(atoms.atom_at_unchecked(x, y, z))];
-  built.for_each_voxel([&](Index3 v) {
-    if (d.contains(v)) ++present[std::size_t(atoms.atom_at(v))];
-  });
+  const auto [voxels, present] = atom_fill(atoms, built);
   const double voxel_volume = std::pow(atoms.lattice().voxel_size, 3);
   std::vector<Shortfall> out;
   for (int a = 0; a < n; ++a) {
@@ -116,6 +127,58 @@ std::vector<Shortfall> find_skipped_layer_shortfalls(const PlanningProblem& prob
           if (std::none_of(out.begin(), out.end(), [a](const Shortfall& s) { return s.atom == a; }))
             out.push_back({primitive, a, problem.atoms[std::size_t(a)].volume});
         }
+  }
+  return out;
+}
+
+std::vector<Shortfall> find_spills(const PlanningProblem& problem, const AtomDecomposition& atoms, const Plan& plan,
+                                   std::size_t steps, const geometry::Solid& built,
+                                   const std::vector<RejectionReason>& reasons) {
+  const std::size_t executed = std::min(steps, plan.steps.size());
+  int deposit = -1;  // the last deposit executed, raw stock aside
+  for (std::size_t k = 0; k < executed; ++k) {
+    const PrimitiveSpec& prim = problem.primitives[std::size_t(plan.steps[k].primitive)];
+    if (prim.mode == Mode::Additive && !prim.raw_stock) deposit = int(k);
+  }
+  if (deposit < 0) return {};
+  const int n = atoms.atom_count();
+  const PlannedState planned = planned_state(problem, n, plan, executed);
+  const auto [voxels, present] = atom_fill(atoms, built);
+  const int primitive = plan.steps[std::size_t(deposit)].primitive;
+  // The atoms with material near the worst excess.
+  std::vector<char> near_worst(std::size_t(n), 0);
+  const geometry::Lattice& lattice = atoms.lattice();
+  for (const RejectionReason& reason : reasons) {
+    if (reason.kind != "excess_material" || !reason.where) continue;
+    const Index3 at{int(std::floor((reason.where->x - lattice.origin.x) / lattice.voxel_size)),
+                    int(std::floor((reason.where->y - lattice.origin.y) / lattice.voxel_size)),
+                    int(std::floor((reason.where->z - lattice.origin.z) / lattice.voxel_size))};
+    for (int dz = -2; dz <= 2; ++dz)
+      for (int dy = -2; dy <= 2; ++dy)
+        for (int dx = -2; dx <= 2; ++dx) {
+          const Index3 v{at.x + dx, at.y + dy, at.z + dz};
+          if (atoms.domain().contains(v) && built.contains(v)) near_worst[std::size_t(atoms.atom_at(v))] = 1;
+        }
+  }
+  // The removals that spare the design: with one that holds the atom, a plan may clear
+  // what spilled there, and the deposit is not to blame for it.
+  std::vector<char> sparing(problem.primitives.size(), 0);
+  for (std::size_t i = 0; i < problem.primitives.size(); ++i) {
+    const PrimitiveSpec& prim = problem.primitives[i];
+    if (prim.mode != Mode::Subtractive) continue;
+    sparing[i] = 1;
+    for (int a = 0; a < n && sparing[i]; ++a) sparing[i] = !(problem.atoms[std::size_t(a)].must_in && prim.atoms.test(a));
+  }
+  const double voxel_volume = std::pow(lattice.voxel_size, 3);
+  std::vector<Shortfall> out;
+  for (int a = 0; a < n; ++a) {
+    const bool filled = 2 * present[std::size_t(a)] > voxels[std::size_t(a)] || near_worst[std::size_t(a)];
+    if (!problem.atoms[std::size_t(a)].must_out || planned.state.test(a) || !filled) continue;
+    // Held by the deposit, or by a removal after it: then the model knows the material and
+    // another action fell short, not this one.
+    bool held = problem.primitives[std::size_t(primitive)].atoms.test(a);
+    for (std::size_t i = 0; i < problem.primitives.size(); ++i) held = held || (sparing[i] && problem.primitives[i].atoms.test(a));
+    if (!held) out.push_back({primitive, a, double(voxels[std::size_t(a)]) * voxel_volume, true});
   }
   return out;
 }

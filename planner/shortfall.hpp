@@ -7,7 +7,8 @@
 // edge). When an atom the plan needs is not as planned after the action that last changed
 // it, that action's primitive fell short on that atom. The planner then takes the atom out
 // of the primitive and searches again, instead of offering validation thousands of plans
-// that count on the same action for the same atom.
+// that count on the same action for the same atom. A deposit can also put material on an
+// atom outside its primitive (a spill): that atom is added to the primitive instead.
 
 #include <cstddef>
 #include <utility>
@@ -24,6 +25,9 @@ struct Shortfall {
   int primitive = -1;  // the action's primitive
   int atom = -1;       // the atom it did not deposit (additive) or did not clear (subtractive)
   double volume = 0;   // mm^3: the atom's
+  // The other way round: a deposit that put material on an atom outside its primitive
+  // (find_spills); learned as an atom it deposits too.
+  bool spill = false;
   friend bool operator==(const Shortfall&, const Shortfall&) = default;
 };
 
@@ -69,5 +73,16 @@ std::vector<Shortfall> find_missing_core_shortfalls(const PlanningProblem& probl
 std::vector<Shortfall> find_skipped_layer_shortfalls(const PlanningProblem& problem, const AtomDecomposition& atoms,
                                                      const Plan& plan, std::size_t steps, const geometry::Solid& built,
                                                      const std::vector<RejectionReason>& reasons);
+
+// A deposit's beads reach past its primitive where the model does not see it (under a
+// leaning wall the bead's edge lies out beyond the tolerance where no cutter from above
+// reaches). A must-out atom the plan leaves empty after `steps` actions that holds material
+// (more than half of it, or any within two voxels of where an "excess_material" reason
+// says the part is worst), and that no removal after the deposit holds, is charged to the
+// last deposit executed that is not raw stock: with the atom added to what that primitive
+// deposits, the search knows the material it leaves and that nothing clears it.
+std::vector<Shortfall> find_spills(const PlanningProblem& problem, const AtomDecomposition& atoms, const Plan& plan,
+                                   std::size_t steps, const geometry::Solid& built,
+                                   const std::vector<RejectionReason>& reasons);
 
 }  // namespace hybridctl::planner

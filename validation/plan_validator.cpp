@@ -112,6 +112,7 @@ PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions option
       }
       if (shortfalls.empty())
         shortfalls = planner::find_skipped_layer_shortfalls(r.problem, r.atoms, plan, executed, run.as_built, run.reasons);
+      if (shortfalls.empty()) shortfalls = planner::find_spills(r.problem, r.atoms, plan, executed, run.as_built, run.reasons);
       return planner::CandidateCheck{std::move(run.reasons), std::move(shortfalls)};
     } catch (const InputError& e) {
       // The plan cannot be written for this machine (a move beyond its envelope, ...): it

@@ -127,6 +127,60 @@ TEST(Shortfall, ALayerTheLastActionSkippedChargesTheAtomsMissingWhereTheToolpath
   EXPECT_TRUE(find_skipped_layer_shortfalls(row.problem, row.atoms, row.plan({2, 0}), 2, voxels(0, 4), {skipped}).empty());
 }
 
+// A row of six voxels, the design the first three: a deposit of the design (P0), a removal
+// of the last voxel that spares the design (P1), a stock of the first (P2) and a removal of
+// the last four that cuts the design (P3). Voxels 3 and 4 are one must-out atom that only
+// the cutting removal holds.
+struct SpillRow {
+  AtomDecomposition atoms = AtomDecomposition::recompute(kMm, {{0, 0, 0}, {6, 1, 1}}, {});
+  PlanningProblem problem;
+  SpillRow() {
+    const Solid deposit = voxels(0, 3), sparing = voxels(5, 6), stock = voxels(0, 1), cutting = voxels(2, 6);
+    atoms = AtomDecomposition::recompute(kMm, {{0, 0, 0}, {6, 1, 1}}, {&deposit, &sparing, &stock, &cutting});
+    for (int a = 0; a < atoms.atom_count(); ++a) {
+      const bool design = atoms.code(a).test(0);
+      problem.atoms.push_back({double(atoms.atom_solid(a).voxel_count()), design, !design});
+    }
+    const Mode modes[] = {Mode::Additive, Mode::Subtractive, Mode::Additive, Mode::Subtractive};
+    for (int i = 0; i < 4; ++i) {
+      PrimitiveSpec p;
+      p.mode = modes[i];
+      p.raw_stock = i == 2;
+      p.atoms = AtomSet(atoms.atom_count());
+      for (int a = 0; a < atoms.atom_count(); ++a)
+        if (atoms.code(a).test(i)) p.atoms.set(a);
+      problem.primitives.push_back(std::move(p));
+    }
+  }
+  int atom_at(int x) const { return atoms.atom_at({x, 0, 0}); }
+  Plan plan(std::vector<int> primitives) const {
+    Plan plan;
+    for (int i : primitives) plan.steps.push_back({i, 0, 0});
+    return plan;
+  }
+};
+
+TEST(Shortfall, ADepositThatLeavesMaterialWhereNoRemovalSparingTheDesignReachesSpillsOntoThatAtom) {
+  const SpillRow row;
+  const int beside = row.atom_at(3);
+  ASSERT_EQ(row.atom_at(4), beside);
+  // Both voxels beside the design filled: the deposit is charged with the whole atom.
+  std::vector<Shortfall> found = find_spills(row.problem, row.atoms, row.plan({2, 0}), 2, voxels(0, 5), {});
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0], (Shortfall{0, beside, 2.0, true}));
+  // Half of it: only where validation says the part is worst.
+  EXPECT_TRUE(find_spills(row.problem, row.atoms, row.plan({2, 0}), 2, voxels(0, 4), {}).empty());
+  const RejectionReason worst{"excess_material", 0, 0, "as built, ...", geometry::Vec3{3.5, 0.5, 0.5}};
+  found = find_spills(row.problem, row.atoms, row.plan({2, 0}), 2, voxels(0, 4), {worst});
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].atom, beside);
+  // Material on the last voxel: the sparing removal may clear it; the plan left it, not the deposit.
+  const Solid last = geometry::unite(voxels(0, 3), voxels(5, 6));
+  EXPECT_TRUE(find_spills(row.problem, row.atoms, row.plan({2, 0}), 2, last, {}).empty());
+  // Nothing deposited but the stock: no deposit to charge.
+  EXPECT_TRUE(find_spills(row.problem, row.atoms, row.plan({2}), 1, voxels(0, 5), {}).empty());
+}
+
 // Planning with a validation that turns the first candidate down, reporting that its last
 // action did not do what the plan counts on for one atom: the search stops, the atom is
 // taken out of that primitive, and the next search offers only plans that do not count on
@@ -182,6 +236,47 @@ TEST(Shortfall, PlanningLearnsFromARejectionAndSearchesAgainWithoutIt) {
     EXPECT_EQ(replayed.final_state, plan.final_state);
   }
   EXPECT_NE(learned_text(result).find("falling short of the model on 1 atom"), std::string::npos) << learned_text(result);
+}
+
+// A spill is learned the other way round: the atom joins what the deposit lays, wherever
+// the plan stands, and every plan the search offers after it ends with that atom cleared.
+TEST(Shortfall, PlanningLearnsASpillAsAnAtomTheDepositLaysToo) {
+  const config::Machine machine = config::load_machine(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
+  const geometry::TriangleMesh part = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/flanged-hub.stl");
+  PlanningOptions options;
+  options.voxel_size = 1.0;
+  options.top_k = 2;
+  Shortfall taught;
+  options.validate = [&](const PlanningResult& r, const Plan& plan) {
+    if (taught.atom >= 0) return CandidateCheck{};
+    // The first plan with a deposit: its last spilled onto the largest must-out atom it
+    // does not hold (those before it are turned down with nothing to learn).
+    int deposit = -1;
+    for (const PlanStep& s : plan.steps)
+      if (r.problem.primitives[std::size_t(s.primitive)].mode == Mode::Additive &&
+          !r.problem.primitives[std::size_t(s.primitive)].raw_stock)
+        deposit = s.primitive;
+    if (deposit < 0) return CandidateCheck{{{"missing_material", 0, 0, "not made", std::nullopt}}};
+    for (int a = 0; a < int(r.problem.atoms.size()); ++a) {
+      const AtomSpec& spec = r.problem.atoms[std::size_t(a)];
+      if (spec.must_out && !r.problem.primitives[std::size_t(deposit)].atoms.test(a) &&
+          (taught.atom < 0 || spec.volume > r.problem.atoms[std::size_t(taught.atom)].volume))
+        taught = {deposit, a, spec.volume, true};
+    }
+    return CandidateCheck{{{"excess_material", 0, 0, "material outside", std::nullopt}}, {taught}};
+  };
+  const PlanningResult result = plan_part(part, "flanged-hub.stl", machine, options);
+  ASSERT_GE(taught.atom, 0);
+  ASSERT_EQ(result.learned.size(), 1u);
+  EXPECT_TRUE(result.learned[0].spill);
+  EXPECT_TRUE(result.problem.primitives[std::size_t(taught.primitive)].atoms.test(taught.atom));
+  for (const Plan& plan : result.plans) {
+    EXPECT_FALSE(plan.final_state.test(taught.atom)) << expression(result.problem, plan);
+    EXPECT_TRUE(is_goal(result.problem, plan.final_state)) << expression(result.problem, plan);
+  }
+  EXPECT_NE(learned_text(result).find("1 primitive spilling onto 1 atom outside them"), std::string::npos)
+      << learned_text(result);
+  EXPECT_NE(learned_text(result).find("added to them over 2 searches"), std::string::npos) << learned_text(result);
 }
 
 // When the proof on the corrected problem replays a plan, that plan is executed before
