@@ -174,8 +174,8 @@ std::vector<Shortfall> find_spills(const PlanningProblem& problem, const AtomDec
   for (int a = 0; a < n; ++a) {
     const bool filled = 2 * present[std::size_t(a)] > voxels[std::size_t(a)] || near_worst[std::size_t(a)];
     if (!problem.atoms[std::size_t(a)].must_out || planned.state.test(a) || !filled) continue;
-    // Held by the deposit, or by a removal after it: then the model knows the material and
-    // another action fell short, not this one.
+    // Held by the deposit (the model knows the material there), or by a removal that spares
+    // the design (a plan may clear it: the spill is charged only where nothing can).
     bool held = problem.primitives[std::size_t(primitive)].atoms.test(a);
     for (std::size_t i = 0; i < problem.primitives.size(); ++i) held = held || (sparing[i] && problem.primitives[i].atoms.test(a));
     if (!held) out.push_back({primitive, a, double(voxels[std::size_t(a)]) * voxel_volume, true});
