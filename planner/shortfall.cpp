@@ -28,6 +28,21 @@ PlannedState planned_state(const PlanningProblem& problem, int n, const Plan& pl
   return out;
 }
 
+// The voxels of the domain within two voxels (each way) of a point a reason gives.
+template <typename Fn>
+void for_each_voxel_near(const AtomDecomposition& atoms, const geometry::Vec3& where, Fn fn) {
+  const geometry::Lattice& lattice = atoms.lattice();
+  const Index3 at{int(std::floor((where.x - lattice.origin.x) / lattice.voxel_size)),
+                  int(std::floor((where.y - lattice.origin.y) / lattice.voxel_size)),
+                  int(std::floor((where.z - lattice.origin.z) / lattice.voxel_size))};
+  for (int dz = -2; dz <= 2; ++dz)
+    for (int dy = -2; dy <= 2; ++dy)
+      for (int dx = -2; dx <= 2; ++dx) {
+        const Index3 v{at.x + dx, at.y + dy, at.z + dz};
+        if (atoms.domain().contains(v)) fn(v);
+      }
+}
+
 // Per atom: its voxels in the domain and those of them in `built`.
 struct AtomFill {
   std::vector<std::int64_t> voxels, present;
@@ -110,23 +125,16 @@ std::vector<Shortfall> find_skipped_layer_shortfalls(const PlanningProblem& prob
   const int primitive = plan.steps[std::size_t(step)].primitive;
   const PrimitiveSpec& prim = problem.primitives[std::size_t(primitive)];
   if (prim.mode != Mode::Additive || prim.raw_stock) return {};
-  const geometry::Lattice& lattice = atoms.lattice();
   std::vector<Shortfall> out;
   for (const RejectionReason& reason : reasons) {
     if (reason.kind != "layer_skipped" || reason.action != int(executed) || !reason.where) continue;
-    const Index3 at{int(std::floor((reason.where->x - lattice.origin.x) / lattice.voxel_size)),
-                    int(std::floor((reason.where->y - lattice.origin.y) / lattice.voxel_size)),
-                    int(std::floor((reason.where->z - lattice.origin.z) / lattice.voxel_size))};
-    for (int dz = -2; dz <= 2; ++dz)
-      for (int dy = -2; dy <= 2; ++dy)
-        for (int dx = -2; dx <= 2; ++dx) {
-          const Index3 v{at.x + dx, at.y + dy, at.z + dz};
-          if (!atoms.domain().contains(v) || built.contains(v)) continue;
-          const int a = atoms.atom_at(v);
-          if (last[std::size_t(a)] != step || !problem.atoms[std::size_t(a)].must_in || !state.test(a)) continue;
-          if (std::none_of(out.begin(), out.end(), [a](const Shortfall& s) { return s.atom == a; }))
-            out.push_back({primitive, a, problem.atoms[std::size_t(a)].volume});
-        }
+    for_each_voxel_near(atoms, *reason.where, [&](Index3 v) {
+      if (built.contains(v)) return;
+      const int a = atoms.atom_at(v);
+      if (last[std::size_t(a)] != step || !problem.atoms[std::size_t(a)].must_in || !state.test(a)) return;
+      if (std::none_of(out.begin(), out.end(), [a](const Shortfall& s) { return s.atom == a; }))
+        out.push_back({primitive, a, problem.atoms[std::size_t(a)].volume});
+    });
   }
   return out;
 }
@@ -147,19 +155,11 @@ std::vector<Shortfall> find_spills(const PlanningProblem& problem, const AtomDec
   const int primitive = plan.steps[std::size_t(deposit)].primitive;
   // The atoms with material near the worst excess.
   std::vector<char> near_worst(std::size_t(n), 0);
-  const geometry::Lattice& lattice = atoms.lattice();
-  for (const RejectionReason& reason : reasons) {
-    if (reason.kind != "excess_material" || !reason.where) continue;
-    const Index3 at{int(std::floor((reason.where->x - lattice.origin.x) / lattice.voxel_size)),
-                    int(std::floor((reason.where->y - lattice.origin.y) / lattice.voxel_size)),
-                    int(std::floor((reason.where->z - lattice.origin.z) / lattice.voxel_size))};
-    for (int dz = -2; dz <= 2; ++dz)
-      for (int dy = -2; dy <= 2; ++dy)
-        for (int dx = -2; dx <= 2; ++dx) {
-          const Index3 v{at.x + dx, at.y + dy, at.z + dz};
-          if (atoms.domain().contains(v) && built.contains(v)) near_worst[std::size_t(atoms.atom_at(v))] = 1;
-        }
-  }
+  for (const RejectionReason& reason : reasons)
+    if (reason.kind == "excess_material" && reason.where)
+      for_each_voxel_near(atoms, *reason.where, [&](Index3 v) {
+        if (built.contains(v)) near_worst[std::size_t(atoms.atom_at(v))] = 1;
+      });
   // The removals that spare the design: with one that holds the atom, a plan may clear
   // what spilled there, and the deposit is not to blame for it.
   std::vector<char> sparing(problem.primitives.size(), 0);
@@ -169,7 +169,7 @@ std::vector<Shortfall> find_spills(const PlanningProblem& problem, const AtomDec
     sparing[i] = 1;
     for (int a = 0; a < n && sparing[i]; ++a) sparing[i] = !(problem.atoms[std::size_t(a)].must_in && prim.atoms.test(a));
   }
-  const double voxel_volume = std::pow(lattice.voxel_size, 3);
+  const double voxel_volume = std::pow(atoms.lattice().voxel_size, 3);
   std::vector<Shortfall> out;
   for (int a = 0; a < n; ++a) {
     const bool filled = 2 * present[std::size_t(a)] > voxels[std::size_t(a)] || near_worst[std::size_t(a)];
