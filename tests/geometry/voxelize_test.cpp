@@ -134,7 +134,12 @@ TEST_P(ExamplePartVolume, IsWithinToleranceOfTheMeshVolume) {
 
 INSTANTIATE_TEST_SUITE_P(Examples, ExamplePartVolume,
                          ::testing::Values(ExamplePart{"bracket.stl"}, ExamplePart{"thin-wall-slot.stl"},
-                                           ExamplePart{"overhang.stl"}),
+                                           ExamplePart{"overhang.stl"}, ExamplePart{"fins.stl"},
+                                           ExamplePart{"slots.stl"}, ExamplePart{"ribbed-pocket.stl"},
+                                           ExamplePart{"flanged-hub.stl"}, ExamplePart{"flanged-hub-worn.stl"},
+                                           ExamplePart{"channel-block.stl"}, ExamplePart{"arch-channel-block.stl"},
+                                           ExamplePart{"boss-plate.stl"}, ExamplePart{"tube-plate.stl"},
+                                           ExamplePart{"leaning-wall.stl"}),
                          [](const auto& info) {
                            std::string name = info.param.file;
                            name = name.substr(0, name.find('.'));
