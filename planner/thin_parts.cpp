@@ -35,11 +35,7 @@ DeepestFirst deepest_first(const Solid& region, const Solid& design, Side side, 
   return d;
 }
 
-// The primitives made to the design: those wholly inside it (deposits that lay only the
-// design) and those wholly outside it (removals that never cut it). Where several atoms
-// could keep a thin part or a gap, one of theirs is the choice a plan can honour without
-// a tool's or a bead's voxels fitting the surface exactly: on a round bore's edge the
-// voxels a cutter's sweep leaves are scattered, the ones beside them are clear.
+// Whether two sets share a member.
 bool shares(const AtomSet& a, const AtomSet& b) {
   const std::size_t n = std::min(a.words().size(), b.words().size());
   for (std::size_t w = 0; w < n; ++w)
@@ -47,18 +43,22 @@ bool shares(const AtomSet& a, const AtomSet& b) {
   return false;
 }
 
+// The primitives made to the design: those wholly inside it (deposits that lay only the
+// design) and those wholly outside it (removals that never cut it). Where several atoms
+// could keep a thin part or a gap, one of theirs is the choice a plan can honour without
+// a tool's or a bead's voxels fitting the surface exactly: on a round bore's edge the
+// voxels a cutter's sweep leaves are scattered, the ones beside them are clear.
 struct CleanPrimitives {
   AtomSet inside, outside;
 };
 CleanPrimitives clean_primitives(int primitive_count, const std::vector<AtomMeasures>& m) {
   AtomSet touches_design(primitive_count), touches_air(primitive_count);
+  auto add = [](AtomSet& into, const AtomSet& code) {
+    for (std::size_t w = 0; w < std::min(code.words().size(), into.words().size()); ++w) into.words()[w] |= code.words()[w];
+  };
   for (const AtomMeasures& a : m) {
-    AtomSet& touched = a.voxels_in_design > 0 ? touches_design : touches_air;
-    AtomSet& also = a.voxels_in_design < a.voxels ? touches_air : touches_design;
-    for (std::size_t w = 0; w < std::min(a.code.words().size(), touched.words().size()); ++w) {
-      touched.words()[w] |= a.code.words()[w];
-      also.words()[w] |= a.code.words()[w];
-    }
+    if (a.voxels_in_design > 0) add(touches_design, a.code);
+    if (a.voxels_in_design < a.voxels) add(touches_air, a.code);
   }
   CleanPrimitives c{AtomSet(primitive_count), AtomSet(primitive_count)};
   for (int i = 0; i < primitive_count; ++i) {

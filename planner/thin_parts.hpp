@@ -6,8 +6,10 @@
 // goal outcome, and every voxel of a must-out atom air. A voxel of the zone's `thin`
 // part (design the core does not cover) that lies within the tolerance of no must-in
 // atom gets one: among the atoms of the design voxels within the tolerance of it, one
-// that is neither a sliver nor must-out, preferring the deepest voxel (the ridge of the
-// distance field, the thin part's medial core), becomes must-in. The voxels are visited
+// that is neither a sliver nor must-out, preferring one that a primitive made to the
+// design holds (a deposit wholly inside it; for air, a removal that never cuts it), then
+// the one covering the most, then the deepest voxel (the ridge of the distance field, the
+// thin part's medial core), becomes must-in. The voxels are visited
 // deepest first, so one choice covers much of a thin part. The same for `narrow` air
 // with must-out atoms (air outside the planning domain is always empty). Only when every
 // atom near a voxel is must-out (or every one near an air voxel must-in) does the choice

@@ -133,9 +133,11 @@ TEST(ThinParts, AGapIsKeptOpenByAnAtomACutterClearOfTheDesignRemoves) {
   }
   EXPECT_GT(cleared, 0);
   const Solid milled = subtract(block, clean);
-  for (std::size_t a = 0; a < m.size(); ++a)
-    if (m[a].atom_class == AtomClass::MustOut)
+  for (std::size_t a = 0; a < m.size(); ++a) {
+    if (m[a].atom_class == AtomClass::MustOut) {
       EXPECT_TRUE(intersect(milled, atoms.atom_solid(int(a))).empty()) << "must-out atom " << a << " is left";
+    }
+  }
   const Deviation d = measure_deviation(milled, design, kDomain, 1.0);
   EXPECT_TRUE(d.within_tolerance) << "out " << d.worst_out << ", missing " << d.worst_missing;
 }
