@@ -24,30 +24,35 @@ const geometry::IndexBox kRow{{0, 0, 0}, {4, 1, 1}};  // four voxels along X
 
 Solid voxels(int x0, int x1) { return Solid::filled(kMm, {{x0, 0, 0}, {x1, 1, 1}}); }
 
-// A row of four voxels: a deposit of all four (P0), a removal of the last (P1), and a
-// stock of the first (P2). The design is the first three voxels.
+// Primitives along a row of voxels (P0, P1, ... in the order given; `stock` the raw
+// stock's index) and a design of the first `design` voxels: an atom inside it is must-in,
+// one outside must-out, its volume its voxels'.
 struct Row {
   AtomDecomposition atoms = AtomDecomposition::recompute(kMm, kRow, {});
   PlanningProblem problem;
-  Row() {
-    const Solid deposit = voxels(0, 4), removal = voxels(3, 4), stock = voxels(0, 1);
-    atoms = AtomDecomposition::recompute(kMm, kRow, {&deposit, &removal, &stock});
+  Row(int length, const std::vector<std::pair<Solid, Mode>>& primitives, int stock, int design) {
+    std::vector<const Solid*> regions;
+    for (const auto& [region, mode] : primitives) regions.push_back(&region);
+    atoms = AtomDecomposition::recompute(kMm, {{0, 0, 0}, {length, 1, 1}}, regions);
     for (int a = 0; a < atoms.atom_count(); ++a) {
-      const bool last = atoms.code(a).test(1);
-      problem.atoms.push_back({1.0, !last, last});
+      const Solid voxels_of = atoms.atom_solid(a);
+      const bool inside = voxels_of.bounding_box().hi.x <= design;
+      problem.atoms.push_back({double(voxels_of.voxel_count()), inside, !inside});
     }
-    const Mode modes[] = {Mode::Additive, Mode::Subtractive, Mode::Additive};
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < int(primitives.size()); ++i) {
       PrimitiveSpec p;
       p.name = "P" + std::to_string(i);
-      p.mode = modes[i];
-      p.raw_stock = i == 2;
+      p.mode = primitives[std::size_t(i)].second;
+      p.raw_stock = i == stock;
       p.atoms = AtomSet(atoms.atom_count());
       for (int a = 0; a < atoms.atom_count(); ++a)
         if (atoms.code(a).test(i)) p.atoms.set(a);
       problem.primitives.push_back(std::move(p));
     }
   }
+  // A row of four voxels: a deposit of all four (P0), a removal of the last (P1), and a
+  // stock of the first (P2). The design is the first three voxels.
+  Row() : Row(4, {{voxels(0, 4), Mode::Additive}, {voxels(3, 4), Mode::Subtractive}, {voxels(0, 1), Mode::Additive}}, 2, 3) {}
   int atom_at(int x) const { return atoms.atom_at({x, 0, 0}); }
   Plan plan(std::vector<int> primitives) const {
     Plan plan;
@@ -131,37 +136,17 @@ TEST(Shortfall, ALayerTheLastActionSkippedChargesTheAtomsMissingWhereTheToolpath
 // of the last voxel that spares the design (P1), a stock of the first (P2) and a removal of
 // the last four that cuts the design (P3). Voxels 3 and 4 are one must-out atom that only
 // the cutting removal holds.
-struct SpillRow {
-  AtomDecomposition atoms = AtomDecomposition::recompute(kMm, {{0, 0, 0}, {6, 1, 1}}, {});
-  PlanningProblem problem;
-  SpillRow() {
-    const Solid deposit = voxels(0, 3), sparing = voxels(5, 6), stock = voxels(0, 1), cutting = voxels(2, 6);
-    atoms = AtomDecomposition::recompute(kMm, {{0, 0, 0}, {6, 1, 1}}, {&deposit, &sparing, &stock, &cutting});
-    for (int a = 0; a < atoms.atom_count(); ++a) {
-      const bool design = atoms.code(a).test(0);
-      problem.atoms.push_back({double(atoms.atom_solid(a).voxel_count()), design, !design});
-    }
-    const Mode modes[] = {Mode::Additive, Mode::Subtractive, Mode::Additive, Mode::Subtractive};
-    for (int i = 0; i < 4; ++i) {
-      PrimitiveSpec p;
-      p.mode = modes[i];
-      p.raw_stock = i == 2;
-      p.atoms = AtomSet(atoms.atom_count());
-      for (int a = 0; a < atoms.atom_count(); ++a)
-        if (atoms.code(a).test(i)) p.atoms.set(a);
-      problem.primitives.push_back(std::move(p));
-    }
-  }
-  int atom_at(int x) const { return atoms.atom_at({x, 0, 0}); }
-  Plan plan(std::vector<int> primitives) const {
-    Plan plan;
-    for (int i : primitives) plan.steps.push_back({i, 0, 0});
-    return plan;
-  }
-};
+Row spill_row() {
+  return Row(6,
+             {{voxels(0, 3), Mode::Additive},
+              {voxels(5, 6), Mode::Subtractive},
+              {voxels(0, 1), Mode::Additive},
+              {voxels(2, 6), Mode::Subtractive}},
+             2, 3);
+}
 
 TEST(Shortfall, ADepositThatLeavesMaterialWhereNoRemovalSparingTheDesignReachesSpillsOntoThatAtom) {
-  const SpillRow row;
+  const Row row = spill_row();
   const int beside = row.atom_at(3);
   ASSERT_EQ(row.atom_at(4), beside);
   // Both voxels beside the design filled: the deposit is charged with the whole atom.
