@@ -465,10 +465,12 @@ std::vector<Pass> DepositionBuilder::passes_of(const SliceMask& region, const Sl
   const bool reverse_start = (layer / int(angles_.size())) % 2 == 1;
   std::vector<Pass> contour;
   RasterResult infill;
-  if (options_.contour != ContourPass::None) {
-    contour = contour_layer(region, lattice_, inset_, min_length_);
+  if (options_.contour != ContourPass::None) contour = contour_layer(region, lattice_, inset_, min_length_);
+  if (!contour.empty()) {
     infill = raster_layer(shrink_by_disc(region, s_ / h_), lattice_, angle, s_, min_length_, inset_, reverse_start);
   } else {
+    // No contour fits (a region narrower than a bead everywhere): rasters alone, whose
+    // segments along the region may still fit, and whose dropped ones are counted.
     infill = raster_layer(region, lattice_, angle, s_, min_length_, inset_, reverse_start, &wall);
   }
   dropped_total_ += infill.dropped;

@@ -28,6 +28,9 @@
 namespace hybridctl::toolpaths {
 
 // Where a layer's contour (a pass along the region's edge, half a bead inside it) goes.
+// Contour first is what slicers for DED and wire-arc do: rasters alone end in rounded
+// bead ends that leave scallops along every edge not parallel to them, which on a thin
+// wall or a ring are more than a tolerance of a few tenths deep.
 enum class ContourPass {
   None,          // rasters only
   BeforeInfill,  // contour first, then rasters inside it
@@ -38,7 +41,7 @@ struct DepositionOptions {
   // Raster angle of layer i, degrees from the work frame's +X towards +Y: the list is
   // used cyclically. The default alternates 0 and 90 degrees. Any angle is allowed.
   std::vector<double> raster_angles_deg = {0.0, 90.0};
-  ContourPass contour = ContourPass::None;
+  ContourPass contour = ContourPass::BeforeInfill;
   // How far segment ends stay inside the region along the raster (mm), so that the
   // bead's end does not spill out. Default: half the bead width. An end against material
   // already there (the existing solid, in the same layer) runs to the region's edge: the

@@ -195,7 +195,7 @@ TEST_F(Cli, TheSlotsOnTheBAxisMachineHaveNoPlanLeftOnceExecutionHasCorrectedTheM
   const Outcome r = run({"plan", kParts + "slots.stl", "--machine", kBAxisMachine, "-o", (dir_ / "plan").string()});
   EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
   EXPECT_NE(r.out.find("verdict     UNDECIDED: no plan is left once the primitives are corrected by what execution "
-                       "showed (1 candidate rejected; executed candidates showed 1 primitive falling short"),
+                       "showed (1 candidate rejected; executed candidates showed "),
             std::string::npos)
       << r.out;
   EXPECT_NE(r.out.find("): on the corrected primitives, no sequence of the 64 primitives gets these"), std::string::npos)
@@ -221,19 +221,18 @@ TEST_F(Cli, TheTubeOnAPlateIsMilledFromTheBlockOnTheBAxisMachineAtAToleranceOfAV
   EXPECT_EQ(r.out.find("finer than a voxel"), std::string::npos) << r.out;
 }
 
-// A wall leaning 30 degrees on hybrid-3axis: the overfill laid along its outer face spills
-// under it, where no cutter that spares the design reaches. Learned from the first such
-// candidate, the search stops offering the same deposit (it turned down 200 in 15 s before).
-TEST_F(Cli, ALeaningWallsSpillUnderItsFaceIsLearnedFromOneCandidate) {
+// A wall leaning 30 degrees on hybrid-3axis, deposited on its milled base: each layer's
+// contour bead runs along the wall's faces, so the outer face, which no cutter from above
+// reaches, is laid within tolerance as it is (rasters alone left it notched and spilled
+// under it, and all 200 candidates were turned down in 15 s).
+TEST_F(Cli, ALeaningWallIsDepositedOnItsMilledBaseAndEveryPlanIsWithinTolerance) {
   const Outcome r = run({"plan", kParts + "leaning-wall.stl", "--machine", kMachine});
-  EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
-  EXPECT_NE(r.out.find("spilling onto"), std::string::npos) << r.out;
-  std::smatch m;
-  ASSERT_TRUE(std::regex_search(r.out, m, std::regex("validated   [^\\n]*; ([0-9]+) candidates? rejected"))) << r.out;
-  EXPECT_LE(std::stoi(m[1]), 20) << r.out;
-  // With a millimetre of play the wall is deposited on the milled base.
-  const Outcome loose = run({"plan", kParts + "leaning-wall.stl", "--machine", kMachine, "--tolerance", "1.0"});
-  EXPECT_EQ(loose.exit_code, 0) << loose.err << loose.out;
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("0 candidates rejected"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("  1. ((((P1 \u2212 "), std::string::npos) << r.out;  // milled from the block
+  EXPECT_NE(r.out.find(") \u222A P3)  cost"), std::string::npos) << r.out;    // then the wall deposited
+  EXPECT_NE(r.out.find("proven optimal"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("not within tolerance"), std::string::npos) << r.out;
 }
 
 TEST_F(Cli, PlansTheFlangedHubAndWritesPlanJsonWithValidPlans) {

@@ -148,7 +148,9 @@ TEST(DepositionPath, ContourPassesStayInTheRegionToo) {
   DepositionOptions o;
   o.contour = ContourPass::BeforeInfill;
   const Toolpath with = deposition_path(roi, Solid(kLattice, {}), head, top_setup(), o);
-  const Toolpath without = deposition_path(roi, Solid(kLattice, {}), head, top_setup());
+  DepositionOptions rasters_only;
+  rasters_only.contour = ContourPass::None;
+  const Toolpath without = deposition_path(roi, Solid(kLattice, {}), head, top_setup(), rasters_only);
   expect_segments_in_region(with, roi, head.layer_height);
   EXPECT_GT(deposition_segments(with).size(), deposition_segments(without).size());
   // The contour comes first in a layer: the first deposition moves turn corners.
@@ -206,7 +208,9 @@ double direction_deg(const Segment& s) {
 
 TEST(DepositionPath, RasterDirectionAlternatesBetweenLayers) {
   const Solid roi = box({{0, 0, 0}, {10, 8, 3}});
-  const Toolpath p = deposition_path(roi, Solid(kLattice, {}), ded_head(), top_setup());
+  DepositionOptions o;
+  o.contour = ContourPass::None;  // the rasters' own directions
+  const Toolpath p = deposition_path(roi, Solid(kLattice, {}), ded_head(), top_setup(), o);
   std::map<double, std::set<int>> by_layer;
   for (const auto& s : deposition_segments(p)) by_layer[s.a.z].insert(int(std::lround(direction_deg(s))) % 180);
   ASSERT_GE(by_layer.size(), 4u);
@@ -227,6 +231,7 @@ TEST(DepositionPath, ArbitraryRasterAnglesFollowTheOptions) {
   const auto head = ded_head();
   DepositionOptions o;
   o.raster_angles_deg = {30, 120, 210};
+  o.contour = ContourPass::None;  // the rasters' own directions
   const Toolpath p = deposition_path(roi, Solid(kLattice, {}), head, top_setup(), o);
   expect_segments_in_region(p, roi, head.layer_height);
   std::map<double, std::set<int>> by_layer;
