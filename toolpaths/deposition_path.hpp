@@ -7,9 +7,10 @@
 // Work frame (toolpaths/setup_frame.hpp): the setup's approach direction is +Z. Layers of the
 // head's layer_height go bottom-up from the ROI's lowest voxel face. A layer's region is
 // the ROI's voxels whose centres lie in the layer's band [z, z + layer_height) (the
-// voxel at the band's middle when it holds no centre). Raster lines at hatch_spacing, at an
-// angle that changes from layer to layer, are clipped to the region; deposition is on
-// along the clipped segments only. Between segments the head lifts by travel_clearance
+// voxel at the band's middle when it holds no centre). By default a contour bead runs
+// along the region's edge first; raster lines at hatch_spacing, at an angle that changes
+// from layer to layer, are clipped to the region inside it; deposition is on along the
+// contour and the clipped segments only. Between segments the head lifts by travel_clearance
 // above the material under the travel (existing material and everything deposited so
 // far, within the nozzle's radius) and comes down again. Rapids never touch material,
 // even with the bead's volume: near the work (approach_gap above the material under the

@@ -1,7 +1,7 @@
 // A 40 x 30 x 10 base with a wall 6 thick and 20 long standing on it (x = 10..16 at its
 // foot, y = 5..25) that leans out 30 degrees from the vertical towards +X, 15 mm tall
-// (z = 10..25). The lean builds without support, but a bead laid along its outer face
-// spills under it where no cutter from above reaches (docs/validation.md, spills).
+// (z = 10..25). The lean builds without support, and no cutter from above reaches its
+// outer face: the deposit must lay that face within tolerance as it is.
 // Regenerate with ./make-parts.
 union() {
   cube([40, 30, 10]);
