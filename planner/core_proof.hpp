@@ -35,6 +35,14 @@ struct CoreProofLimits {
   const std::atomic<bool>* stop = nullptr;
 };
 
+// A quarter of the budget, for proofs that may run several in a row (a corrected
+// problem's, each raw stock's): about a second at most.
+inline CoreProofLimits quick_proof_limits() {
+  CoreProofLimits l;
+  l.max_states /= 4;
+  return l;
+}
+
 struct CoreProof {
   enum class Outcome { Proven, Feasible, Unknown };
   Outcome outcome = Outcome::Unknown;

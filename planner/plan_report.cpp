@@ -153,6 +153,33 @@ json rejected_json(const PlanningResult& r) {
   return rejected;
 }
 
+// The raw stocks proven before the search to start no plan: why the search never starts
+// from them (planner/start_proofs.hpp).
+std::string stock_starts_text(const PlanningResult& r) {
+  std::string out;
+  for (const StartProof& s : r.stock_starts) {
+    if (s.proof.outcome != CoreProof::Outcome::Proven) continue;
+    const Primitive& p = r.primitives[std::size_t(s.primitive)];
+    out += "stocks      no plan starts from " + p.name + " (" + p.label + "): no sequence after it gets " +
+           std::to_string(s.proof.core.size()) + " atom" + (s.proof.core.size() == 1 ? "" : "s") +
+           " right together (proven over " + std::to_string(s.proof.states) + " states)\n";
+  }
+  return out;
+}
+
+json stock_starts_json(const PlanningResult& r) {
+  json out = json::array();
+  for (const StartProof& s : r.stock_starts) {
+    const CoreProof::Outcome o = s.proof.outcome;
+    out.push_back({{"primitive", r.primitives[std::size_t(s.primitive)].name},
+                   {"starts_a_plan", o == CoreProof::Outcome::Proven ? json(false)
+                                     : o == CoreProof::Outcome::Feasible ? json(true)
+                                                                          : json(nullptr)},
+                   {"atoms", o == CoreProof::Outcome::Proven ? json(s.proof.core) : json::array()}});
+  }
+  return out;
+}
+
 // One line per candidate that failed when executed, with its first reasons.
 std::string rejected_summary(const PlanningResult& r) {
   std::ostringstream os;
@@ -357,7 +384,8 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
                    {"lower_bound", r.search.lower_bound},
                    {"seconds", r.search.seconds},
                    {"rounds", r.search_rounds},
-                   {"replays", r.replay_rounds}};
+                   {"replays", r.replay_rounds},
+                   {"stock_starts", stock_starts_json(r)}};
 
   const json plans = plans_json(r);
   doc["plans"] = plans;
@@ -488,6 +516,7 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
   const std::size_t shown = std::min<std::size_t>(r.verdict.violations.size(), 10);
   for (std::size_t i = 0; i < shown; ++i) os << "  - " << r.verdict.violations[i].description << "\n";
   if (r.verdict.violations.size() > shown) os << "  ... and " << r.verdict.violations.size() - shown << " more in plan.json\n";
+  os << stock_starts_text(r);
   if (r.validated) os << rejected_summary(r);
   if (r.plans.empty() && r.tolerance < r.lattice.voxel_size) os << finer_than_voxel_note(r);
   if (!r.plans.empty()) {
@@ -501,7 +530,7 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
       std::ostringstream weight;
       weight << r.search.weight;
       if (r.search.weight > 1) sources.push_back("weighted A* (w = " + weight.str() + ")");
-      if (replayed) sources.push_back("the proof's replay (a plan it found checking that one exists)");
+      if (replayed) sources.push_back("the proofs' replays (plans they found checking that one exists)");
       if (built) sources.push_back("plans built step by step (deposit the missing design, then mill what lies outside it)");
       for (std::size_t i = 0; i < sources.size(); ++i) os << (i ? " and " : "") << sources[i];
       os << " with a proven gap against the lower bound " << fixed(r.search.lower_bound, 4);

@@ -436,10 +436,8 @@ void take_in(Learning& learning, PlanningResult& r) {
 // showed corrects the problem again without a search (a tube on a plate on the B-axis
 // machine: one search instead of two). A replay that passes leads the next search's seeds.
 CoreProof correct_by_replays(SearchOptions& search, std::int64_t max_rejected, Learning& learning, PlanningResult& r) {
-  CoreProofLimits quick;
-  quick.max_states = quick.max_states / 4;
   for (;;) {
-    CoreProof corrected = prove_by_core(r.problem, quick);
+    CoreProof corrected = prove_by_core(r.problem, quick_proof_limits());
     if (corrected.outcome != CoreProof::Outcome::Feasible) return corrected;
     search.seeds = {corrected.sequence};
     Plan replay;
@@ -470,6 +468,8 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
   search.known_to_fail = known_failure_hook(options, r);
   search.max_rejected = options.max_rejected;
   if (r.core_proof.outcome == CoreProof::Outcome::Feasible) search.seeds.push_back(r.core_proof.sequence);
+  for (const StartProof& s : r.stock_starts)
+    if (s.proof.outcome == CoreProof::Outcome::Feasible) search.seeds.push_back(s.proof.sequence);
   // A rejection that showed a primitive falling short stops the search: the next one runs
   // on the problem without what the primitive does not do (planner/shortfall.hpp).
   if (options.learn)
@@ -650,6 +650,7 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
     // not; the search cannot prove a hybrid problem infeasible short of exhausting it.
     r.core_proof = prove_by_core(r.problem);
     if (r.core_proof.outcome == CoreProof::Outcome::Proven) r.verdict = core_verdict(r.problem, r.core_proof, r.measures, r.lattice);
+    else r.stock_starts = prove_stock_starts(r.problem, quick_proof_limits());
     clock.lap("proof");
   }
   if (r.verdict.manufacturable) search_beside_a_longer_proof(top_k, options, progress, r, validation_seconds);

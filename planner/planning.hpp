@@ -11,6 +11,7 @@
 #include "geometry/mesh.hpp"
 #include "planner/atoms.hpp"
 #include "planner/core_proof.hpp"
+#include "planner/start_proofs.hpp"
 #include "planner/fine_graining.hpp"
 #include "planner/check.hpp"
 #include "planner/costing.hpp"
@@ -119,6 +120,9 @@ struct PlanningResult {
   // The proof from a few atoms tried before the search (planner/core_proof.hpp); Proven
   // decides the verdict.
   CoreProof core_proof;
+  // Each raw stock proven on its own before the search: whether a plan starts from it
+  // (planner/start_proofs.hpp); those that start none are `never_first` in `problem`.
+  std::vector<StartProof> stock_starts;
   // What the plans' costs are in (minutes, money or cost factors), and each plan's
   // estimate in minutes and money whatever the objective, with the machine's currency.
   config::Objective objective = config::Objective::CostFactor;

@@ -257,7 +257,16 @@ void fill_with_greedy(const PlanningProblem& p, const SearchOptions& options, st
   for (const Plan& plan : plans) known.insert(sequence_of(plan));
   GoalFilter goals(p, options, known, st);
   int taken = 0;
-  std::vector<std::vector<int>> sequences = options.seeds;
+  // The seeds cheapest first, each once (the proofs' replays come in no order).
+  std::vector<std::pair<double, std::vector<int>>> costed;
+  for (const std::vector<int>& seed : options.seeds) {
+    Plan plan;
+    if (simulate(p, seed, plan)) costed.emplace_back(plan.cost, seed);
+  }
+  std::sort(costed.begin(), costed.end());
+  costed.erase(std::unique(costed.begin(), costed.end()), costed.end());
+  std::vector<std::vector<int>> sequences;
+  for (auto& c : costed) sequences.push_back(std::move(c.second));
   const std::size_t seeds = sequences.size();
   for (std::vector<int>& sequence : greedy_sequences(p, kGreedyCandidates)) sequences.push_back(std::move(sequence));
   for (std::size_t k = 0; k < sequences.size(); ++k) {

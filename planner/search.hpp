@@ -53,6 +53,9 @@ struct PrimitiveSpec {
   // Atoms the action does not change once the plan has begun (in a state that holds
   // material), as executed candidates showed (planner/shortfall.hpp); empty: none.
   AtomSet falls_short;
+  // Proven that no plan starts with it (planner/start_proofs.hpp): never a first action.
+  // A raw stock so marked is in no plan at all.
+  bool never_first = false;
 };
 
 // What changing between two consecutive actions costs (in the problem's cost units, before
@@ -168,8 +171,9 @@ struct SearchOptions {
   bool reduce = true;
   SearchDirection direction = SearchDirection::Auto;
   // Sequences found elsewhere that reach the goal (the proof from a few atoms replays one,
-  // planner/core_proof.hpp): when the exact search stops at a limit, judged before the
-  // plans built step by step, as they are.
+  // planner/core_proof.hpp, and so does each raw stock's, planner/start_proofs.hpp): when
+  // the exact search stops at a limit, judged cheapest first before the plans built step
+  // by step, as they are.
   std::vector<std::vector<int>> seeds;
 };
 

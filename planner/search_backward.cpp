@@ -128,6 +128,7 @@ double BackwardSearch::start_cost(const View& v) const {
 bool BackwardSearch::whole(const Node& node, const std::vector<std::uint64_t>& decided) const {
   if (node.primitive < 0 || !additive(p_, node.primitive)) return false;
   if (p_.start_from_stock && !p_.primitives[std::size_t(node.primitive)].raw_stock) return false;
+  if (p_.primitives[std::size_t(node.primitive)].never_first) return false;
   for (std::size_t w = 0; w < decided.size(); ++w)
     if (must_in_[w] & ~decided[w]) return false;
   return true;

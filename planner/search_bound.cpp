@@ -160,7 +160,8 @@ std::vector<char> LowerBound::needed_lists(const AtomSet& state) const {
 std::vector<bool> LowerBound::usable(const std::vector<std::uint8_t>& uses, bool first) const {
   std::vector<bool> candidates(p_.primitives.size());
   for (std::size_t i = 0; i < p_.primitives.size(); ++i)
-    candidates[i] = uses[i] < p_.max_uses && (first || !p_.primitives[i].raw_stock);
+    candidates[i] = uses[i] < p_.max_uses && (first ? !(p_.primitives[i].raw_stock && p_.primitives[i].never_first)
+                                                    : !p_.primitives[i].raw_stock);
   return closure_.usable(std::move(candidates));
 }
 

@@ -91,7 +91,7 @@ double fixed_cost(const PlanningProblem& p, int previous, int next) {
 bool allowed(const PlanningProblem& p, int i, bool first, const std::vector<std::uint8_t>& uses) {
   const PrimitiveSpec& prim = p.primitives[std::size_t(i)];
   if (uses[std::size_t(i)] >= p.max_uses) return false;
-  if (first) return prim.mode == Mode::Additive && (!p.start_from_stock || prim.raw_stock);  // C3
+  if (first) return !prim.never_first && prim.mode == Mode::Additive && (!p.start_from_stock || prim.raw_stock);  // C3
   return !prim.raw_stock;                         // C4
 }
 

@@ -221,6 +221,20 @@ TEST_F(Cli, TheTubeOnAPlateIsMilledFromTheBlockOnTheBAxisMachineAtAToleranceOfAV
   EXPECT_EQ(r.out.find("finer than a voxel"), std::string::npos) << r.out;
 }
 
+// The same tube at the B-axis machine's own tolerance, 0.3 mm, under a voxel: only a part
+// made voxel for voxel is within it, and no cutter's voxels follow the bore. The block's
+// own proof before the search replays a plan from it: the block milled down to the plate
+// and the tube deposited, each layer's contour bead along its faces (docs/search.md, "Each
+// raw stock proven on its own"). It is offered first, executed voxel for voxel.
+TEST_F(Cli, TheTubeOnAPlateAtTheMachinesToleranceIsDepositedOnTheMilledBlock) {
+  const Outcome r = run({"plan", kParts + "tube-plate.stl", "--machine", kBAxisMachine});
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("  1. (((P2 \u2212 "), std::string::npos) << r.out;  // from the block
+  EXPECT_NE(r.out.find(") \u222A P7)  cost"), std::string::npos) << r.out;   // the tube deposited
+  EXPECT_NE(r.out.find("0.0 mm\u00B3 over, 0.0 mm\u00B3 under"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("0 candidates rejected"), std::string::npos) << r.out;
+}
+
 // A wall leaning 30 degrees on hybrid-3axis, deposited on its milled base: each layer's
 // contour bead runs along the wall's faces, so the outer face, which no cutter from above
 // reaches, is laid within tolerance as it is (rasters alone left it notched and spilled

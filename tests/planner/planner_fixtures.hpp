@@ -2,6 +2,8 @@
 // Building planning problems from voxel primitives, as the planner does, so the tests
 // exercise the symbolic search on real atom decompositions.
 
+#include <algorithm>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -71,6 +73,32 @@ inline Solid atoms_union(const VoxelProblem& vp, const AtomSet& set) {
   std::vector<bool> selected(static_cast<std::size_t>(vp.atoms.atom_count()));
   for (int a = 0; a < vp.atoms.atom_count(); ++a) selected[std::size_t(a)] = set.test(a);
   return vp.atoms.union_of(selected);
+}
+
+// A random instance whose design is the outcome of a random valid plan, so that
+// solutions exist; primitives are boxes in a small grid.
+inline VoxelProblem random_instance(std::mt19937& rng, int n) {
+  const Lattice kUnit{1.0, {0, 0, 0}};
+  std::uniform_real_distribution<double> at(0, 10), size(2, 8), cost(0.2, 3.0);
+  std::vector<VoxelPrimitive> prims;
+  for (int i = 0; i < n; ++i) {
+    const Mode mode = i == 0 || rng() % 2 ? Mode::Additive : Mode::Subtractive;
+    const double x = at(rng), y = at(rng), z = at(rng) / 3;
+    prims.push_back({"P" + std::to_string(i + 1), mode, i == 0 && rng() % 2, cost(rng),
+                     geometry::make_box(kUnit, {{x, y, z}, {x + size(rng), y + size(rng), z + size(rng) / 2}})});
+  }
+  const IndexBox domain{{0, 0, 0}, {18, 18, 8}};
+  std::vector<int> order(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) order[std::size_t(i)] = i;
+  std::shuffle(order.begin() + 1, order.end(), rng);  // P1 (additive) first
+  const int length = 1 + int(rng() % unsigned(n));
+  Solid design(kUnit, domain);
+  for (int s = 0; s < length; ++s) {
+    const VoxelPrimitive& p = prims[std::size_t(order[std::size_t(s)])];
+    design = p.mode == Mode::Additive ? unite(design, p.region) : subtract(design, p.region);
+  }
+  design = intersect(design, Solid::filled(kUnit, domain));
+  return make_problem(std::move(prims), design, domain);
 }
 
 }  // namespace hybridctl::planner::testing

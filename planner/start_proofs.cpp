@@ -1,0 +1,26 @@
+#include "planner/start_proofs.hpp"
+
+#include <algorithm>
+
+namespace hybridctl::planner {
+
+std::vector<StartProof> prove_stock_starts(PlanningProblem& problem, const CoreProofLimits& limits) {
+  std::vector<StartProof> out;
+  int starts = 0;
+  for (const PrimitiveSpec& p : problem.primitives)
+    starts += !p.never_first && p.mode == Mode::Additive && (p.raw_stock || !problem.start_from_stock);
+  if (starts < 2) return out;
+  for (std::size_t s = 0; s < problem.primitives.size(); ++s) {
+    if (!problem.primitives[s].raw_stock || problem.primitives[s].never_first) continue;
+    PlanningProblem only = problem;  // with only this stock to start from
+    for (std::size_t i = 0; i < only.primitives.size(); ++i) only.primitives[i].never_first = only.primitives[i].never_first || i != s;
+    out.push_back({int(s), prove_by_core(only, limits)});
+  }
+  const auto ruled_out = std::count_if(out.begin(), out.end(), [](const StartProof& s) { return s.proof.outcome == CoreProof::Outcome::Proven; });
+  if (ruled_out == starts) return out;
+  for (const StartProof& s : out)
+    if (s.proof.outcome == CoreProof::Outcome::Proven) problem.primitives[std::size_t(s.primitive)].never_first = true;
+  return out;
+}
+
+}  // namespace hybridctl::planner
