@@ -91,7 +91,7 @@ int export_plan_programs(const planner::PlanFile& file, const ExportRequest& req
 void add_export_command(CLI::App& app, Runner& runner) {
   auto request = std::make_shared<ExportRequest>();
   auto* cmd = app.add_subcommand("export",
-                                 "Turn a plan's actions into G-code: raster deposition and pocket milling per action, "
+                                 "Turn a plan's actions into G-code: deposition (contour then rasters) and pocket milling per action, "
                                  "one program per action plus one for the whole plan, and a LinuxCNC tool table; "
                                  "each action planned against the material the ones before it leave, the program "
                                  "executed on the simulated machine from the raw stock first (exit 4 and nothing "
