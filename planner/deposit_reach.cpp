@@ -102,7 +102,6 @@ std::vector<AtomSet> atoms_in_nozzle_reach(const AtomDecomposition& atoms, geome
   if (atoms.domain().empty() || nozzle.radius <= 0) return reach;
   const ColumnFrame f(atoms.domain(), approach);
   const int nu = f.nu(), nv = f.nv(), len = f.length();
-  if (len > nozzle.standoff + nozzle.length) return reach;
   // Per column the atoms in it with their lowest and highest voxel along the build axis,
   // and per atom its columns' box.
   constexpr int kNone = -1;
@@ -173,7 +172,10 @@ std::vector<AtomSet> atoms_in_nozzle_reach(const AtomDecomposition& atoms, geome
           if (t == kNone) continue;
           for (const Entry& e : in_column[std::size_t(v) * std::size_t(nu) + std::size_t(u)]) {
             const int other = e.atom;
-            if (other == a || t < e.lowest + nozzle.standoff) continue;
+            // `a`'s highest voxel near the column lies in the body over some voxel of
+            // `other` there: from the stand-off over its lowest to the body's top over its
+            // highest. Higher than that, the body might pass under it: not counted.
+            if (other == a || t < e.lowest + nozzle.standoff || t > e.highest + nozzle.standoff + nozzle.length) continue;
             AtomSet& s = l.reach[std::size_t(other)];
             if (s.words().empty()) s = AtomSet(n);
             s.set(a);

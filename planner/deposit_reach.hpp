@@ -32,8 +32,9 @@ struct NozzleReach {
 // For each atom b, the atoms a with a voxel inside the nozzle body placed over some voxel
 // of b: present, they meet the nozzle when the head deposits b (the simulator's
 // body_collision). The body is taken as the square inscribed in its circle (never more
-// than the nozzle), and when the domain is taller than the body's top along `approach`
-// the relation is left empty, as it ignores how far up the body ends.
+// than the nozzle), and `a` counts when its highest voxel near the column lies between the
+// stand-off over b's lowest voxel there and the body's top over b's highest (an atom that
+// reaches above the body's top may pass over it: not counted).
 std::vector<AtomSet> atoms_in_nozzle_reach(const AtomDecomposition& atoms, geometry::AxisDirection approach,
                                            const NozzleReach& nozzle);
 

@@ -219,6 +219,8 @@ class DepositionBuilder {
 
   double corridor_top(Vec2 a, Vec2 b) const;
   double footprint_top(Vec2 p) const;
+  bool touches(const Pass& p, const SliceMask& mask) const;
+  bool body_meets_material(const Pass& p, double zb) const;
   double clear_height(Vec2 p, double z) const { return std::max(z, footprint_top(p) + gap_); }
   void move(MoveKind kind, Vec3 to, double feed, bool on, std::string comment = {});
   void travel_to(Vec2 p, double z);
@@ -243,7 +245,7 @@ class DepositionBuilder {
   // Emission state.
   bool started_ = false;
   Vec3 at_{};
-  int warnings_overhang_ = 0, dropped_total_ = 0, warnings_uncounted_ = 0;
+  int warnings_overhang_ = 0, dropped_total_ = 0, warnings_uncounted_ = 0, body_skipped_ = 0;
   double overhang_area_total_ = 0, uncounted_area_total_ = 0;
 };
 
@@ -353,6 +355,30 @@ double DepositionBuilder::footprint_top(Vec2 p) const {
       if (cx * cx + cy * cy <= r * r + 1e-9) top = std::max(top, travel_top_.at(x, y));
     }
   return top;
+}
+
+// Whether the pass runs through a cell of `mask` (sampled every half voxel).
+bool DepositionBuilder::touches(const Pass& p, const SliceMask& mask) const {
+  for (std::size_t i = 0; i + 1 < p.points.size(); ++i) {
+    const Vec2 a = p.points[i], b = p.points[i + 1];
+    const int steps = 1 + int(std::ceil(std::hypot(b.x - a.x, b.y - a.y) / (h_ / 2)));
+    for (int s = 0; s <= steps; ++s) {
+      const double f = double(s) / steps;
+      const int x = int(std::floor((a.x + f * (b.x - a.x) - lattice_.origin.x) / h_));
+      const int y = int(std::floor((a.y + f * (b.y - a.y) - lattice_.origin.y) / h_));
+      if (mask.at(x, y)) return true;
+    }
+  }
+  return false;
+}
+
+// Whether material within the nozzle's radius of the pass stands above the body's tip
+// (stand-off over the layer's bottom) anywhere along it.
+bool DepositionBuilder::body_meets_material(const Pass& p, double zb) const {
+  const double tip = zb + head_.nozzle->standoff;
+  for (std::size_t i = 0; i + 1 < p.points.size(); ++i)
+    if (corridor_top(p.points[i], p.points[i + 1]) > tip + 1e-9) return true;
+  return false;
 }
 
 void DepositionBuilder::move(MoveKind kind, Vec3 to, double feed, bool on, std::string comment) {
@@ -497,7 +523,18 @@ void DepositionBuilder::deposit_layer(int layer, double zb) {
   const double angle = angles_[std::size_t(layer) % angles_.size()];
   bool first_of_layer = true;
   const SliceMask wall = existing_.empty() ? empty_mask_ : slice_of(existing_, k, window_);
+  // A pass the plan does not count on this action for (earlier actions were to lay it) is
+  // left out where the nozzle body over it would meet material beside it: the machine
+  // would stop there (body_collision), and the part is judged by what it lacks instead.
+  // The passes the plan counts on are the planner's to keep clear (planner/deposit_reach.hpp).
+  const bool check_body = counted_ && head_.nozzle;
+  int counted_top = 0;
+  const SliceMask counted_here = check_body ? layer_region(*counted_, zb, counted_top) : empty_mask_;
   for (const Pass& p : passes_of(region, wall, layer, angle)) {
+    if (check_body && !touches(p, counted_here) && body_meets_material(p, zb)) {
+      ++body_skipped_;
+      continue;
+    }
     travel_to(p.points.front(), zb);
     for (std::size_t i = 1; i < p.points.size(); ++i) {
       std::string comment;
@@ -525,6 +562,9 @@ void DepositionBuilder::finish() {
   if (warnings_uncounted_ > kMaxWarningsPerKind)
     path_.warnings.push_back("under existing material: " + std::to_string(warnings_uncounted_) + " layers in all, " +
                              mm(uncounted_area_total_) + " mm^2 that earlier actions were to lay, left out");
+  if (body_skipped_ > 0)
+    path_.warnings.push_back(std::to_string(body_skipped_) + " passes that earlier actions were to lay left out: the " +
+                             "nozzle body over them would meet material beside them");
   if (dropped_total_ > 0)
     path_.warnings.push_back(std::to_string(dropped_total_) + " raster segments shorter than " + mm(min_length_) +
                              " mm dropped (narrow parts of the region stay unfilled)");

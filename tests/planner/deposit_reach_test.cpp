@@ -94,8 +94,16 @@ TEST(AtomsInNozzleReach, AreTheAtomsTheBodyMeetsOverTheDeposit) {
   const auto far_reach = atoms_in_nozzle_reach(far.atoms, kFromAbove, nozzle);
   EXPECT_TRUE(far_reach[std::size_t(far_pad)].words().empty() || !far_reach[std::size_t(far_pad)].test(far_wall));
 
-  // A body shorter than the domain is tall: the relation does not know where it ends.
-  for (const AtomSet& s : atoms_in_nozzle_reach(near.atoms, kFromAbove, {10, 5, 20})) EXPECT_TRUE(s.words().empty());
+  // A body shorter than the domain is tall (20 of 30 voxels) still meets the wall: its top
+  // (voxel 19) lies within the body over the pad, from 5 above its foot to 25 above its top.
+  const auto short_body = atoms_in_nozzle_reach(near.atoms, kFromAbove, {10, 5, 20});
+  ASSERT_FALSE(short_body[std::size_t(pad)].words().empty());
+  EXPECT_TRUE(short_body[std::size_t(pad)].test(wall));
+  // A body 3 long ends 9 above the pad's top: the wall's top stands above it, and the
+  // relation, which knows only each atom's highest voxel near a column, does not count it
+  // (never more than the nozzle meets).
+  const auto stub = atoms_in_nozzle_reach(near.atoms, kFromAbove, {10, 5, 3});
+  EXPECT_TRUE(stub[std::size_t(pad)].words().empty() || !stub[std::size_t(pad)].test(wall));
 }
 
 // Random decompositions of a small domain, seen from a few approaches, against the

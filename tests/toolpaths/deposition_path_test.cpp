@@ -421,6 +421,37 @@ TEST(DepositionPath, RoiUnderExistingMaterialThatThePlanDoesNotCountOnIsLeftOutW
   EXPECT_EQ(counted.defects.front().kind, "layer_skipped");
 }
 
+TEST(DepositionPath, PassesThePlanDoesNotCountOnAreLeftOutWhereTheNozzleBodyWouldMeetMaterialBesideThem) {
+  // A plate with an 11 mm wall on it, a pad far from the wall and one right beside it. The
+  // nozzle (10 mm across, its tip 3 mm over the bead's bottom) coming down to the near pad
+  // would meet the wall. When an earlier action was to lay the near pad (the plan does not
+  // count on this one for it), its passes are left out with a warning; when the plan
+  // counts on this action for it, they stay: keeping those clear is the planner's
+  // (planner/deposit_reach.hpp), and the simulated machine stops on them.
+  const Solid existing = geometry::unite(box({{0, 0, 0}, {30, 10, 1}}), box({{14, 0, 1}, {16, 10, 12}}));
+  const Solid far_pad = box({{2, 2, 1}, {6, 8, 2}}), near_pad = box({{17, 2, 1}, {20, 8, 2}});
+  const Solid roi = geometry::unite(far_pad, near_pad);
+  auto head = ded_head();
+  head.nozzle = config::Nozzle{10, 40, 3};
+  DepositionOptions o;
+  o.counted_on = &far_pad;
+  const Toolpath p = deposition_path(roi, existing, head, top_setup(), o);
+  EXPECT_TRUE(has_warning(p, "nozzle body over them would meet material")) << "said, not hidden";
+  bool far_laid = false;
+  for (const auto& s : deposition_segments(p))
+    along(s.a, s.b, 0.05, [&](Vec3 q) {
+      EXPECT_LT(q.x, 16) << "a pass beside the wall";
+      far_laid = far_laid || q.x < 6;
+    });
+  EXPECT_TRUE(far_laid);
+  o.counted_on = &roi;
+  const Toolpath counted = deposition_path(roi, existing, head, top_setup(), o);
+  EXPECT_FALSE(has_warning(counted, "nozzle body"));
+  bool near_laid = false;
+  for (const auto& s : deposition_segments(counted)) along(s.a, s.b, 0.05, [&](Vec3 q) { near_laid = near_laid || q.x > 17; });
+  EXPECT_TRUE(near_laid);
+}
+
 TEST(DepositionPath, OtherSetupsWorkInTheirWorkFrame) {
   // Deposit from below (approach -Z): in the part frame the layers grow downwards.
   const Solid existing = box({{0, 0, 5}, {10, 10, 8}});
