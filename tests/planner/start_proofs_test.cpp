@@ -25,6 +25,12 @@ PrimitiveSpec primitive(std::string name, Mode mode, int atoms, std::initializer
   return s;
 }
 
+SearchOptions top(int k) {
+  SearchOptions o;
+  o.top_k = k;
+  return o;
+}
+
 // A part D with waste W around it, and a closed void V inside the block: the block costs
 // nothing and milling the waste is cheap, but no cutter reaches V, so no plan starts from
 // the block; the part is deposited instead.
@@ -47,7 +53,7 @@ TEST(StockStarts, AStockThatHoldsWhatNoRemovalClearsStartsNoPlanAndIsNeverFirst)
   EXPECT_EQ(starts[0].proof.outcome, CoreProof::Outcome::Proven);
   EXPECT_TRUE(part.p.primitives[0].never_first);
   EXPECT_FALSE(detail::allowed(part.p, 0, true, std::vector<std::uint8_t>(3, 0)));
-  const auto plans = find_plans(part.p, {3});
+  const auto plans = find_plans(part.p, top(3));
   ASSERT_EQ(plans.size(), 1u);
   EXPECT_EQ(expression(part.p, plans[0]), "deposit");
   EXPECT_NEAR(plans[0].cost, 200, 1e-9);
@@ -94,7 +100,7 @@ TEST(StockStarts, TheOptimumIsTheExhaustiveEnumeratorsWithStocksRuledOut) {
     PlanningProblem marked = p;
     const std::vector<StartProof> starts = prove_stock_starts(marked, {});
     for (const StartProof& s : starts) ruled_out += marked.primitives[std::size_t(s.primitive)].never_first;
-    const auto found = find_plans(marked, {1});
+    const auto found = find_plans(marked, top(1));
     ASSERT_EQ(found.size(), oracle.size()) << "trial " << trial;
     if (!oracle.empty()) {
       EXPECT_NEAR(found[0].cost, oracle[0].cost, 1e-9 * std::max(1.0, oracle[0].cost)) << "trial " << trial;
