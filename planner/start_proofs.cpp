@@ -13,13 +13,15 @@ std::vector<StartProof> prove_stock_starts(PlanningProblem& problem, const CoreP
   for (std::size_t s = 0; s < problem.primitives.size(); ++s) {
     if (!problem.primitives[s].raw_stock || problem.primitives[s].never_first) continue;
     PlanningProblem only = problem;  // with only this stock to start from
-    for (std::size_t i = 0; i < only.primitives.size(); ++i) only.primitives[i].never_first = only.primitives[i].never_first || i != s;
+    for (std::size_t i = 0; i < only.primitives.size(); ++i)
+      if (i != s) only.primitives[i].never_first = true;
     out.push_back({int(s), prove_by_core(only, limits)});
   }
-  const auto ruled_out = std::count_if(out.begin(), out.end(), [](const StartProof& s) { return s.proof.outcome == CoreProof::Outcome::Proven; });
+  const auto proven = [](const StartProof& s) { return s.proof.outcome == CoreProof::Outcome::Proven; };
+  const auto ruled_out = std::count_if(out.begin(), out.end(), proven);
   if (ruled_out == starts) return out;
   for (const StartProof& s : out)
-    if (s.proof.outcome == CoreProof::Outcome::Proven) problem.primitives[std::size_t(s.primitive)].never_first = true;
+    if (proven(s)) problem.primitives[std::size_t(s.primitive)].never_first = true;
   return out;
 }
 
