@@ -102,8 +102,8 @@ TEST(AtomsInNozzleReach, AreTheAtomsTheBodyMeetsOverTheDeposit) {
   // A body 3 long ends 9 above the pad's top: the wall's top stands above it, and the
   // relation, which knows only each atom's highest voxel near a column, does not count it
   // (never more than the nozzle meets).
-  const auto stub = atoms_in_nozzle_reach(near.atoms, kFromAbove, {10, 5, 3});
-  EXPECT_TRUE(stub[std::size_t(pad)].words().empty() || !stub[std::size_t(pad)].test(wall));
+  const auto three_long = atoms_in_nozzle_reach(near.atoms, kFromAbove, {10, 5, 3});
+  EXPECT_TRUE(three_long[std::size_t(pad)].words().empty() || !three_long[std::size_t(pad)].test(wall));
 }
 
 // Random decompositions of a small domain, seen from a few approaches, against the

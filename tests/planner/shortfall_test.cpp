@@ -166,15 +166,21 @@ TEST(Shortfall, ADepositThatLeavesMaterialWhereNoRemovalSparingTheDesignReachesS
   EXPECT_TRUE(find_spills(row.problem, row.atoms, row.plan({2}), 1, voxels(0, 5), {}).empty());
 }
 
+// The bundled flanged hub on hybrid-3axis at 1 mm, planned with the test's options (its
+// validation hook stands in for execution).
+PlanningResult plan_flanged_hub(PlanningOptions options) {
+  static const config::Machine machine = config::load_machine(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
+  static const geometry::TriangleMesh part = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/flanged-hub.stl");
+  options.voxel_size = 1.0;
+  return plan_part(part, "flanged-hub.stl", machine, options);
+}
+
 // Planning with a validation that turns the first candidate down, reporting that its last
 // action did not do what the plan counts on for one atom: the search stops, the atom is
 // taken out of that primitive, and the next search offers only plans that do not count on
 // it; the first candidate is not offered again.
 TEST(Shortfall, PlanningLearnsFromARejectionAndSearchesAgainWithoutIt) {
-  const config::Machine machine = config::load_machine(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
-  const geometry::TriangleMesh part = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/flanged-hub.stl");
   PlanningOptions options;
-  options.voxel_size = 1.0;
   options.top_k = 2;
   std::vector<std::vector<int>> offered;
   Shortfall taught;
@@ -195,7 +201,7 @@ TEST(Shortfall, PlanningLearnsFromARejectionAndSearchesAgainWithoutIt) {
     }
     return CandidateCheck{{{"missing_material", 0, 0, "the atom is not there", std::nullopt}}, {taught}};
   };
-  const PlanningResult result = plan_part(part, "flanged-hub.stl", machine, options);
+  const PlanningResult result = plan_flanged_hub(options);
   ASSERT_GE(taught.atom, 0);
   ASSERT_EQ(result.rejected.size(), 1u);
   ASSERT_EQ(result.learned.size(), 1u);
@@ -226,10 +232,7 @@ TEST(Shortfall, PlanningLearnsFromARejectionAndSearchesAgainWithoutIt) {
 // A spill is learned the other way round: the atom joins what the deposit lays, wherever
 // the plan stands, and every plan the search offers after it ends with that atom cleared.
 TEST(Shortfall, PlanningLearnsASpillAsAnAtomTheDepositLaysToo) {
-  const config::Machine machine = config::load_machine(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
-  const geometry::TriangleMesh part = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/flanged-hub.stl");
   PlanningOptions options;
-  options.voxel_size = 1.0;
   options.top_k = 2;
   Shortfall taught;
   options.validate = [&](const PlanningResult& r, const Plan& plan) {
@@ -250,7 +253,7 @@ TEST(Shortfall, PlanningLearnsASpillAsAnAtomTheDepositLaysToo) {
     }
     return CandidateCheck{{{"excess_material", 0, 0, "material outside", std::nullopt}}, {taught}};
   };
-  const PlanningResult result = plan_part(part, "flanged-hub.stl", machine, options);
+  const PlanningResult result = plan_flanged_hub(options);
   ASSERT_GE(taught.atom, 0);
   ASSERT_EQ(result.learned.size(), 1u);
   EXPECT_TRUE(result.learned[0].spill);
@@ -269,10 +272,7 @@ TEST(Shortfall, PlanningLearnsASpillAsAnAtomTheDepositLaysToo) {
 // atom. The second is the proof's replay, and what it showed corrects the problem again
 // without a search; the search after it offers a plan that passes.
 TEST(Shortfall, TheCorrectedProofsReplayIsExecutedBeforeAnotherSearch) {
-  const config::Machine machine = config::load_machine(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
-  const geometry::TriangleMesh part = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/flanged-hub.stl");
   PlanningOptions options;
-  options.voxel_size = 1.0;
   options.top_k = 1;
   std::vector<std::vector<int>> offered;
   int searches_when_offered[2] = {0, 0};
@@ -294,7 +294,7 @@ TEST(Shortfall, TheCorrectedProofsReplayIsExecutedBeforeAnotherSearch) {
     }
     return CandidateCheck{{{"missing_material", 0, 0, "the atom is not there", std::nullopt}}, {taught}};
   };
-  const PlanningResult result = plan_part(part, "flanged-hub.stl", machine, options);
+  const PlanningResult result = plan_flanged_hub(options);
   ASSERT_EQ(result.rejected.size(), 2u);
   ASSERT_EQ(result.learned.size(), 2u);
   EXPECT_EQ(result.replay_rounds, 1);
