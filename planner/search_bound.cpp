@@ -57,6 +57,8 @@ struct LowerBound::Rates {
   std::vector<bool> allowed;
   std::vector<double> rate;  // per list
   double deposit(std::size_t a) const { return rate[std::size_t(bound.adder_list_[a])]; }
+  // The least its last deposit costs (a must-in atom; any other: deposit()).
+  double last_deposit(std::size_t a) const { return rate[std::size_t(bound.last_adder_list_[a])]; }
   double remove(std::size_t a) const { return rate[std::size_t(bound.remover_list_[a])]; }
 };
 
@@ -97,6 +99,56 @@ LowerBound::LowerBound(const PlanningProblem& p)
   index_lists();
 }
 
+// After the last deposit of a must-in atom nothing takes it away. So the action that lays
+// it last cannot also lay a must-out atom that only removals holding the atom take away
+// (it would be cut after, and laid again): such an adder is left out of the atom's list of
+// last adders. Per must-out atom, the atoms every removal of it holds are worked out once
+// per remover list. A remover's or an adder's atoms are what it changes once begun (less
+// what it falls short of): for an adder fewer must-out atoms, so never a last adder too few.
+std::vector<std::vector<int>> LowerBound::last_adders() const {
+  const PlanningProblem& p = p_;
+  const std::size_t words = must_in_.size();
+  auto changes = [&](int i) {
+    std::vector<std::uint64_t> w = p.primitives[std::size_t(i)].atoms.words();
+    w.resize(words, 0);
+    const auto& short_of = p.primitives[std::size_t(i)].falls_short.words();
+    for (std::size_t k = 0; k < words && k < short_of.size(); ++k) w[k] &= ~short_of[k];
+    return w;
+  };
+  std::map<int, std::vector<std::uint64_t>> held_by_all;  // per remover list id
+  auto held = [&](std::size_t b) -> const std::vector<std::uint64_t>& {
+    const int l = remover_list_[b];
+    auto [it, added] = held_by_all.emplace(l, std::vector<std::uint64_t>(words, ~std::uint64_t{0}));
+    if (added)
+      for (int r : lists_[std::size_t(l)]) {
+        const std::vector<std::uint64_t> cut = changes(r);
+        for (std::size_t k = 0; k < words; ++k) it->second[k] &= cut[k];
+      }
+    return it->second;
+  };
+  std::vector<std::vector<std::uint64_t>> not_last(p.primitives.size());
+  for (std::size_t i = 0; i < p.primitives.size(); ++i) {
+    if (p.primitives[i].mode != Mode::Additive) continue;
+    not_last[i].assign(words, 0);
+    const std::vector<std::uint64_t> laid = changes(int(i));
+    for (std::size_t w = 0; w < words; ++w)
+      for (std::uint64_t b = laid[w] & must_out_[w]; b; b &= b - 1) {
+        const auto& all = held(w * 64 + std::size_t(std::countr_zero(b)));
+        for (std::size_t k = 0; k < words; ++k) not_last[i][k] |= all[k];
+      }
+  }
+  std::vector<std::vector<int>> out(static_cast<std::size_t>(atoms_));
+  for (int a = 0; a < atoms_; ++a) {
+    if (!p.atoms[std::size_t(a)].must_in) {
+      out[std::size_t(a)] = adders_[std::size_t(a)];
+      continue;
+    }
+    for (int i : adders_[std::size_t(a)])
+      if (!((not_last[std::size_t(i)][std::size_t(a / 64)] >> (a % 64)) & 1u)) out[std::size_t(a)].push_back(i);
+  }
+  return out;
+}
+
 // The distinct supplier lists and the bit masks fixed_part works with.
 void LowerBound::index_lists() {
   const PlanningProblem& p = p_;
@@ -110,6 +162,7 @@ void LowerBound::index_lists() {
     adder_list_.push_back(id_of(adders_[std::size_t(a)]));
     remover_list_.push_back(id_of(removers_[std::size_t(a)]));
   }
+  for (const std::vector<int>& list : last_adders()) last_adder_list_.push_back(id_of(list));
   // The lists, tools and setups as bit masks over the primitives.
   const std::size_t prim_words = (p.primitives.size() + 63) / 64;
   auto mask = [&](auto member) {
@@ -147,11 +200,17 @@ std::vector<double> LowerBound::per_primitive(const std::vector<double>& per_lis
   return out;
 }
 
-std::vector<char> LowerBound::needed_lists(const AtomSet& state) const {
+bool LowerBound::lays_last(int i, int a) const {
+  const std::vector<int>& list = lists_[std::size_t(last_adder_list_[std::size_t(a)])];
+  return std::find(list.begin(), list.end(), i) != list.end();
+}
+
+std::vector<char> LowerBound::needed_lists(const AtomSet& state, bool last) const {
   std::vector<char> needed(lists_.size(), 0);
   const auto& s = state.words();
+  const std::vector<int>& adder_list = last ? last_adder_list_ : adder_list_;
   for (std::size_t w = 0; w < s.size(); ++w) {
-    for (std::uint64_t b = must_in_[w] & ~s[w]; b; b &= b - 1) needed[std::size_t(adder_list_[w * 64 + std::size_t(std::countr_zero(b))])] = 1;
+    for (std::uint64_t b = must_in_[w] & ~s[w]; b; b &= b - 1) needed[std::size_t(adder_list[w * 64 + std::size_t(std::countr_zero(b))])] = 1;
     for (std::uint64_t b = must_out_[w] & s[w]; b; b &= b - 1) needed[std::size_t(remover_list_[w * 64 + std::size_t(std::countr_zero(b))])] = 1;
   }
   return needed;
@@ -175,7 +234,7 @@ LowerBound::AtomShares LowerBound::atom_part(const AtomSet& state, const Rates& 
   for (std::size_t w = 0; w < s.size(); ++w) {
     for (std::uint64_t b = must_in_[w] & ~s[w]; b; b &= b - 1) {
       const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
-      h.deposits += r.deposit(a) * p_.atoms[a].volume;
+      h.deposits += r.last_deposit(a) * p_.atoms[a].volume;
     }
     for (std::uint64_t b = must_out_[w] & s[w]; b; b &= b - 1) {
       const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
@@ -203,7 +262,7 @@ double LowerBound::removals_with_design_cut(const AtomSet& state, const Rates& r
   for (std::size_t w = 0; w < s.size(); ++w)
     for (std::uint64_t b = s[w] & must_in_[w]; b; b &= b - 1) {
       const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
-      per_list[std::size_t(remover_list_[a])] += r.deposit(a) * p_.atoms[a].volume;
+      per_list[std::size_t(remover_list_[a])] += r.last_deposit(a) * p_.atoms[a].volume;
     }
   const std::vector<double> cut_share = per_primitive(per_list);
   std::vector<std::pair<double, int>> shares;
@@ -219,7 +278,7 @@ double LowerBound::removals_with_design_cut(const AtomSet& state, const Rates& r
         const std::uint64_t cut = pa[w] & s[w] & must_in_[w] & ~(w < short_of.size() ? short_of[w] : 0);
         for (std::uint64_t b = cut; b; b &= b - 1) {
           const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
-          share += r.deposit(a) * p_.atoms[a].volume;
+          share += r.last_deposit(a) * p_.atoms[a].volume;
         }
       }
     }
@@ -302,11 +361,16 @@ LowerBound::SideShares LowerBound::side_effects(const AtomSet& state, const Rate
   const std::vector<char> needed = needed_lists(state);
   // Per list, the volume of its atoms that are wrong: the first of its suppliers a
   // completion uses changes all of them (no other primitive holds them), at its own rate.
-  std::vector<double> wrong(lists_.size(), 0);
+  // What the atom part charged them: the cheapest rate, or for a must-in atom the least its
+  // last deposit costs, at most the dearest of those per list (a last deposit by the
+  // supplier is charged its rate beyond that; any other deposit of the atom all of it).
+  std::vector<double> wrong(lists_.size(), 0), charged = r.rate;
   for (std::size_t w = 0; w < s.size(); ++w) {
     for (std::uint64_t b = must_in_[w] & ~s[w]; b; b &= b - 1) {
       const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
-      wrong[std::size_t(adder_list_[a])] += p_.atoms[a].volume;
+      const std::size_t l = std::size_t(adder_list_[a]);
+      wrong[l] += p_.atoms[a].volume;
+      charged[l] = std::max(charged[l], r.last_deposit(a));
     }
     for (std::uint64_t b = must_out_[w] & s[w]; b; b &= b - 1) {
       const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
@@ -314,17 +378,17 @@ LowerBound::SideShares LowerBound::side_effects(const AtomSet& state, const Rate
     }
   }
   // Some primitive must change each needed atom: the first of the list's suppliers used
-  // pays its side effects and, beyond the cheapest rate the atom part charged, its own rate
-  // on the list's wrong atoms (not when it falls short: then it may change only some). The
+  // pays its side effects and, beyond the rate the atom part charged, its own rate on the
+  // list's wrong atoms (not when it falls short: then it may change only some). The
   // dearest such obligation counts.
   auto least = [&](std::size_t l) {
     const std::vector<int>& suppliers = lists_[l];
-    const double cheapest = r.rate[l];
     double best = kInfinity;
     for (int i : suppliers) {
       if (!r.allowed[std::size_t(i)]) continue;
       const PrimitiveSpec& prim = p_.primitives[std::size_t(i)];
-      const double dearer = prim.falls_short.words().empty() ? (prim.cost_per_mm3 - cheapest) * wrong[l] : 0.0;
+      const double dearer =
+          prim.falls_short.words().empty() ? std::max(0.0, prim.cost_per_mm3 - charged[l]) * wrong[l] : 0.0;
       best = std::min(best, side[std::size_t(i)] + dearer);
     }
     return best;
@@ -359,7 +423,7 @@ void LowerBound::force(const AtomSet& state, const Rates& r, std::vector<bool>& 
       if (list[w] & allowed_mask[w] & ~same[w]) return;
     forced[std::size_t(id[std::size_t(first_member)])] = true;
   };
-  const std::vector<char> needed = needed_lists(state);
+  const std::vector<char> needed = needed_lists(state, true);
   for (std::size_t l = 0; l < lists_.size(); ++l)
     if (needed[l]) {
       force_one(list_mask_[l], tool_id_, tool_mask_, tool_forced);

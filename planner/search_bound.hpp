@@ -1,10 +1,12 @@
 #pragma once
 // The admissible lower bound of the plan search: what any completion of a partial plan
 // must still pay, from its state, the primitives it may still use and its last action.
-// Three parts, on disjoint shares of the cost so that they add:
+// Its parts, on disjoint shares of the cost so that they add:
 //  - atoms: a missing must-in atom is deposited at least once, a present must-out atom
 //    removed at least once, each at the cheapest rate of a primitive still allowed that
-//    holds it (the classic bound);
+//    holds it (the classic bound), and the must-in atom at the cheapest rate of one that
+//    may lay it last (lays_last: a block's design cut to clear what only the cut reaches
+//    is deposited again by a head that does not fill it in);
 //  - side effects: the primitive that deposits the dearest missing must-in atom also
 //    deposits its absent other atoms (and any must-out one among them must then be
 //    removed); likewise the removal of a must-out atom takes present other atoms with it
@@ -21,9 +23,13 @@
 // Only primitives some suffix of a plan can hold count as still allowed
 // (planner/search_reduce.hpp: SuffixClosure), which makes every part larger and tells
 // dead ends: a wrong atom none of them can fix.
-// The bound is consistent (it never falls by more than an action costs), which the
-// search's duplicate detection relies on; tests/planner/search_test.cpp checks both
-// properties against the exhaustive enumerator.
+// The bound is admissible, and consistent (it never falls by more than an action costs)
+// except across a deposit of a must-in atom that is not its last (lays_last): that drops
+// the atom's charge at the rate of its last deposit, and the charge comes back only partly,
+// through the removals of what the deposit laid with it. The search needs admissibility
+// alone: its duplicate detection compares arrivals at one state, uses and last action,
+// which have one bound, so they are taken in the order of their cost either way.
+// tests/planner/search_test.cpp checks both properties against the exhaustive enumerator.
 
 #include <cstdint>
 #include <vector>
@@ -48,6 +54,11 @@ class LowerBound {
   // The same with `within` taken as the primitives still allowed: any superset of usable()
   // (a parent's, less what the child used up) keeps it a bound, and saves the closure.
   double quick(const AtomSet& state, const std::vector<bool>& within, int last) const;
+
+  // Whether primitive i may be the last to lay must-in atom a: it is not when it also lays
+  // a must-out atom that every removal holding it takes `a` away with. The atom part
+  // charges a missing must-in atom the cheapest rate of the primitives that may.
+  bool lays_last(int i, int a) const;
 
   // The primitives a completion may still use: not used up, no raw stock after the first
   // action, and held by some suffix of a plan reaching the goal.
@@ -78,6 +89,9 @@ class LowerBound {
   // atoms share one, and what the lists force is worked out once per list.
   std::vector<std::vector<int>> lists_;
   std::vector<int> adder_list_, remover_list_;
+  // Per atom its list of the adders that can lay it last (planner/search_bound.cpp).
+  std::vector<int> last_adder_list_;
+  std::vector<std::vector<int>> last_adders() const;
   // Per list the rate of its first (cheapest) member, and per primitive the lists it comes
   // first in: [0] with every primitive allowed, [1] with the raw stocks left out, as they
   // are after the first action (they cost nothing and lead most deposits' lists).
@@ -88,8 +102,9 @@ class LowerBound {
   Leaders leaders_[2];
   // Bit masks over the primitives: per list its members, per tool (setup) id its primitives.
   std::vector<std::vector<std::uint64_t>> list_mask_, tool_mask_, setup_mask_;
-  // Per list with a wrong atom in `state` (must-in missing: adders; must-out present: removers).
-  std::vector<char> needed_lists(const AtomSet& state) const;
+  // Per list with a wrong atom in `state` (must-in missing: adders, or with `last` the
+  // adders that can lay it last; must-out present: removers).
+  std::vector<char> needed_lists(const AtomSet& state, bool last = false) const;
   // Per primitive, the sum over the supplier lists it is on (an atom is held by exactly the
   // primitives of its lists, so a sum over atoms per primitive is one per list, added up).
   std::vector<double> per_primitive(const std::vector<double>& per_list) const;
