@@ -363,6 +363,17 @@ std::vector<Plan> find_plans(const PlanningProblem& p, const SearchOptions& opti
   } else {
     // The search runs on the reduced problem; the caller's hook sees plans in its terms.
     SearchOptions inner = options;
+    // Seeds in the reduced problem's terms: one that uses a primitive no plan can hold is
+    // no plan.
+    std::vector<int> reduced(p.primitives.size(), -1);
+    for (std::size_t i = 0; i < r.primitive.size(); ++i) reduced[std::size_t(r.primitive[i])] = int(i);
+    inner.seeds.clear();
+    for (const std::vector<int>& seed : options.seeds) {
+      std::vector<int> mapped;
+      for (int i : seed)
+        if (i >= 0 && std::size_t(i) < reduced.size() && reduced[std::size_t(i)] >= 0) mapped.push_back(reduced[std::size_t(i)]);
+      if (mapped.size() == seed.size()) inner.seeds.push_back(std::move(mapped));
+    }
     if (options.accept) inner.accept = [&](const Plan& plan) { return options.accept(lift(r, plan)); };
     if (options.known_to_fail)
       inner.known_to_fail = [&](const Plan& plan) { return options.known_to_fail(lift(r, plan)); };

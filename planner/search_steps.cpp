@@ -133,6 +133,7 @@ bool simulate(const PlanningProblem& p, const std::vector<int>& sequence, Plan& 
     AtomSet next;
     double volume = 0;
     // A plan ends where it first reaches the goal.
+    if (i < 0 || std::size_t(i) >= p.primitives.size()) return false;
     if ((last >= 0 && is_goal(p, state)) || !apply(p, state, i, next, volume, last < 0)) return false;
     const double cost = (p.primitives[std::size_t(i)].cost_per_mm3 * volume + fixed_cost(p, last, i)) / p.normaliser;
     plan.steps.push_back({i, volume, cost});

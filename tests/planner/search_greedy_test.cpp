@@ -148,5 +148,34 @@ TEST(Search, WhenTheExactSearchStopsAtItsLimitASeedIsOfferedWithItsGap) {
   EXPECT_EQ(testing::evaluate(vp, *seeded), vp.design);
 }
 
+// The search runs on the problem reduced to the primitives a plan can hold, numbered
+// anew: a seed is given in the caller's numbering, and offered as the plan it names. Here
+// the spill (waste no removal reaches) is left out, so the finisher is the fifth primitive
+// of the reduced problem and the sixth of the caller's.
+TEST(Search, ASeedIsTheCallersPlanWhenTheSearchLeavesPrimitivesOut) {
+  VoxelProblem base = block_and_cutters();
+  std::vector<VoxelPrimitive> prims = base.primitives;
+  prims.insert(prims.begin() + 1, {"spill", Mode::Additive, false, 0.5, box(0, 0, 10, 10)});
+  const VoxelProblem vp = make_problem(std::move(prims), base.design, base.domain);
+  SearchOptions options{2};
+  options.max_expansions = 1;
+  options.direction = SearchDirection::Forward;
+  options.seeds = {{0, 5}};  // the block, milled by the finisher
+  std::vector<std::vector<int>> offered;
+  options.accept = [&](const Plan& plan) {
+    std::vector<int> sequence;
+    for (const PlanStep& s : plan.steps) sequence.push_back(s.primitive);
+    offered.push_back(sequence);
+    return true;
+  };
+  const auto plans = find_plans(vp.problem, options);
+  ASSERT_FALSE(offered.empty());
+  EXPECT_EQ(offered.front(), (std::vector<int>{0, 5}));
+  const auto seeded = std::find_if(plans.begin(), plans.end(), [](const Plan& p) { return p.replayed; });
+  ASSERT_NE(seeded, plans.end());
+  EXPECT_EQ(expression(vp.problem, *seeded), "(block \u2212 finisher)");
+  EXPECT_EQ(testing::evaluate(vp, *seeded), vp.design);
+}
+
 }  // namespace
 }  // namespace hybridctl::planner
