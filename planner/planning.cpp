@@ -428,25 +428,25 @@ void take_in(Learning& learning, PlanningResult& r) {
   learning.pending.clear();
 }
 
-// What execution showed may leave the corrected problem with no plan at all: the proof says
-// so in a moment, where the next search would run to its limit. A quarter of the first
-// proof's budget (about a second) per round, as a round may follow round. When the proof
-// instead replays a plan of the corrected problem, that plan is executed before another
-// search: the search would most likely offer it first, and when it fails too, what it
-// showed corrects the problem again without a search (a tube on a plate on the B-axis
-// machine: one search instead of two). A replay that passes leads the next search's seeds.
+// What execution showed may leave the corrected problem with no plan: the proof (a quarter
+// of the first one's budget) says so in a moment, where a search would run to its limit.
+// A plan it replays is executed before another search (which would likely offer it first);
+// failing, it corrects the problem again without a search; passing, it leads the next
+// search's seeds, ahead of the stocks' (one no longer reaching the design is passed over).
 CoreProof correct_by_replays(SearchOptions& search, std::int64_t max_rejected, Learning& learning, PlanningResult& r) {
   for (;;) {
     CoreProof corrected = prove_by_core(r.problem, quick_proof_limits());
     if (corrected.outcome != CoreProof::Outcome::Feasible) return corrected;
     search.seeds = {corrected.sequence};
+    for (const StartProof& start : r.stock_starts)
+      if (start.proof.outcome == CoreProof::Outcome::Feasible) search.seeds.push_back(start.proof.sequence);
     Plan replay;
     if (!search.accept || !detail::simulate(r.problem, corrected.sequence, replay) || !is_goal(r.problem, replay.final_state) ||
         std::int64_t(r.rejected.size()) >= max_rejected || r.search_rounds + r.replay_rounds >= kMaxLearningRounds)
       return corrected;
     const std::size_t rejected = r.rejected.size();
     if (search.accept(replay) || learning.pending.empty()) {
-      if (r.rejected.size() > rejected) search.seeds.clear();  // failed, and showed nothing to learn
+      if (r.rejected.size() > rejected) search.seeds.erase(search.seeds.begin());  // failed, showed nothing
       return corrected;
     }
     ++r.replay_rounds;

@@ -261,7 +261,7 @@ void fill_with_greedy(const PlanningProblem& p, const SearchOptions& options, st
   std::vector<std::pair<double, std::vector<int>>> costed;
   for (const std::vector<int>& seed : options.seeds) {
     Plan plan;
-    if (simulate(p, seed, plan)) costed.emplace_back(plan.cost, seed);
+    if (simulate(p, seed, plan) && is_goal(p, plan.final_state)) costed.emplace_back(plan.cost, seed);
   }
   std::sort(costed.begin(), costed.end());
   costed.erase(std::unique(costed.begin(), costed.end()), costed.end());
