@@ -177,11 +177,12 @@ struct SearchOptions {
   std::vector<std::vector<int>> seeds;
 };
 
-// The k cheapest distinct accepted plans, cheapest first, by A* with the admissible and
-// consistent bound of planner/search_bound.hpp. When the exact search stops at a limit
-// (expansions, states, half the time budget) before k plans, weighted A* fills the list:
-// w = 50 first (nearly greedy: a plan soon), then w = 5 and w = 2 for cheaper ones, each
-// within the same limits and skipping what cannot beat the plans kept; the cheapest
+// The k cheapest distinct accepted plans, cheapest first, by A* with the admissible
+// bound of planner/search_bound.hpp. When the exact search stops at a limit (expansions,
+// states, half the time budget) before k plans, seeds and plans built step by step, then
+// weighted A* fill the list: w = 50 first (nearly greedy: a plan soon), then w = 5 and
+// w = 2 for cheaper ones, each within the same limits (a quarter of the expansions once
+// there is a plan) and skipping what cannot beat the plans kept; the cheapest
 // distinct plans found are kept, each with its proven gap against the exact search's
 // lower bound (Plan::gap, Plan::exact, SearchStats::lower_bound). With options.weight > 1
 // only that weighted search runs.

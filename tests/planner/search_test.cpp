@@ -521,6 +521,32 @@ TEST(Search, StoppedEarlyItReturnsPlansWithAProvenGap) {
   EXPECT_GT(inexact, 20);  // the limit really cut the exact search short
 }
 
+// With a plan in hand (here a seed, the optimum itself), each weighted pass after the
+// exact search gets a quarter of the expansion limit: the passes hunt for more plans, and
+// one weight finds them in a few expansions where another finds none in the whole limit.
+TEST(Search, WithAPlanInHandEachWeightedPassGetsAQuarterOfTheLimit) {
+  std::mt19937 rng(77);
+  int cut_short = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const VoxelProblem vp = random_instance(rng, 8);
+    const auto oracle = enumerate_plans(vp.problem, 1);
+    if (oracle.empty()) continue;
+    SearchOptions options{50, 40};  // more plans than the passes find: each runs to its limit
+    options.direction = SearchDirection::Forward;
+    std::vector<int> best;
+    for (const PlanStep& step : oracle.front().steps) best.push_back(step.primitive);
+    options.seeds = {best};
+    SearchStats stats;
+    const auto found = find_plans(vp.problem, options, &stats);
+    if (!stats.limit_reached) continue;  // the exact search found every plan
+    ++cut_short;
+    ASSERT_FALSE(found.empty());
+    EXPECT_NEAR(found.front().cost, oracle.front().cost, 1e-9);
+    EXPECT_LE(stats.expanded, 40 + 3 * 10) << "trial " << trial;
+  }
+  EXPECT_GT(cut_short, 5);
+}
+
 TEST(Search, AnUnreachableDesignYieldsNoPlan) {
   std::vector<VoxelPrimitive> prims = {{"A", Mode::Additive, false, 1.0, rect(0, 0, 4, 4)}};
   const Solid design = rect(0, 0, 2, 2);  // a quarter of A: no primitive removes the rest
