@@ -179,7 +179,12 @@ bool same_partition(const AtomDecomposition& a, const AtomDecomposition& b) {
 
 AtomClass class_of(const AtomMeasures& a) {
   const bool in = a.voxels_in_core > 0 || a.thin_feature, out = a.voxels_beyond_hull > 0 || a.thin_gap;
-  return a.sliver ? AtomClass::Free
+  // A sliver is noise where it would make the part impossible: one that holds both a voxel
+  // every plan must keep and one every plan must leave empty is free. One that holds only
+  // one kind is classed as any atom: left free, a milled face's last voxel in a 2-voxel
+  // sliver went unseen until every candidate failed on it (an arc wall at a tolerance
+  // under a voxel: 200 rejected).
+  return a.sliver && in && out ? AtomClass::Free
          : in && out ? AtomClass::Violating
          : in        ? AtomClass::MustIn
          : out       ? AtomClass::MustOut

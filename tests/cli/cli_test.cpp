@@ -187,24 +187,24 @@ TEST_F(Cli, TheOverhangOnTheBAxisMachineIsProvenImpossibleBeforeAnySearch) {
   EXPECT_NE(json.find("\"violations\": [\n"), std::string::npos);
 }
 
-// The slots on the B-axis machine: the model has plans (deposit from +Y, then the slots'
-// edges from the top and the sides), and execution shows the top deposit cannot lay the
-// 0.5 mm strips beside the slots (a bead's inset). Corrected by that, the proof finds no
-// plan, and the search is over; a correction is not a proof, so the word stays UNDECIDED.
-TEST_F(Cli, TheSlotsOnTheBAxisMachineHaveNoPlanLeftOnceExecutionHasCorrectedTheModel) {
+// The slots on the B-axis machine at its own tolerance (0.3 mm, under the 0.5 mm voxel):
+// no cutter fits a slot, so they are never to be filled, and the voxels at the top corners
+// beside them are atoms of their own (slivers, classed as any atom since they hold only
+// design) that no deposit lays without filling a slot too: a bead rounds a corner by a
+// voxel, 0.5 mm. `plan` proves it before any candidate is executed (it used to take a
+// rejected candidate and a correction to say UNDECIDED), and says what would do.
+TEST_F(Cli, TheSlotsOnTheBAxisMachineAreProvenNotManufacturableAtItsToleranceBeforeAnyExecution) {
   const Outcome r = run({"plan", kParts + "slots.stl", "--machine", kBAxisMachine, "-o", (dir_ / "plan").string()});
   EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
-  EXPECT_NE(r.out.find("verdict     UNDECIDED: no plan is left once the primitives are corrected by what execution "
-                       "showed (1 candidate rejected; executed candidates showed "),
+  EXPECT_NE(r.out.find("verdict     NOT manufacturable: not manufacturable: 8 atoms of the design no deposit makes "
+                       "without material outside it that only removals cutting into the atom clear"),
             std::string::npos)
       << r.out;
-  EXPECT_NE(r.out.find("): on the corrected primitives, no sequence of the 64 primitives gets these"), std::string::npos)
-      << r.out;
-  EXPECT_EQ(r.out.find("search stopped at its limit"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("x (((P13 \u222A P52) \u222A P56) \u222A P11)  cost 2.4386: missing_material: action 4"),
+  EXPECT_NE(r.out.find("  - a 0.125 mm\u00B3 region of the design around (15.8, 0.2, 19.8) mm: every deposit that holds it"),
             std::string::npos)
       << r.out;
-  EXPECT_NE(r.out.find("learned     executed candidates showed"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("  x ("), std::string::npos) << r.out;  // no candidate executed
+  EXPECT_NE(r.out.find("note        the tolerance (0.3 mm) is finer than a voxel (0.5 mm)"), std::string::npos) << r.out;
 }
 
 // A tube on a plate on the B-axis machine, with a tolerance of one voxel: the bore's edge
