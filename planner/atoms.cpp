@@ -177,14 +177,11 @@ bool same_partition(const AtomDecomposition& a, const AtomDecomposition& b) {
   return true;
 }
 
-AtomClass class_of(const AtomMeasures& a) {
+bool strict_slivers(double tolerance, double voxel_size) { return tolerance < voxel_size; }
+
+AtomClass class_of(const AtomMeasures& a, bool strict_slivers) {
   const bool in = a.voxels_in_core > 0 || a.thin_feature, out = a.voxels_beyond_hull > 0 || a.thin_gap;
-  // A sliver is noise where it would make the part impossible: one that holds both a voxel
-  // every plan must keep and one every plan must leave empty is free. One that holds only
-  // one kind is classed as any atom: left free, a milled face's last voxel in a 2-voxel
-  // sliver went unseen until every candidate failed on it (an arc wall at a tolerance
-  // under a voxel: 200 rejected).
-  return a.sliver && in && out ? AtomClass::Free
+  return a.sliver && ((in && out) || !strict_slivers) ? AtomClass::Free
          : in && out ? AtomClass::Violating
          : in        ? AtomClass::MustIn
          : out       ? AtomClass::MustOut
@@ -263,6 +260,7 @@ std::vector<AtomMeasures> measure_atoms(const AtomDecomposition& atoms, const So
     }
   });
   const double h = atoms.lattice().voxel_size, v = h * h * h;
+  const bool strict = strict_slivers(zone.tolerance, h);
   for (int i = 0; i < m; ++i) {
     AtomMeasures& a = out[std::size_t(i)];
     a.volume = double(a.voxels) * v;
@@ -274,7 +272,7 @@ std::vector<AtomMeasures> measure_atoms(const AtomDecomposition& atoms, const So
                     a.centroid.z + s.z / double(a.voxels) * h};
     }
     a.sliver = a.volume < sliver_threshold_mm3;
-    a.atom_class = class_of(a);
+    a.atom_class = class_of(a, strict);
   }
   mark_thin_parts(atoms, design, zone, out);
   return out;
