@@ -119,21 +119,26 @@ TEST(Search, WhenTheExactSearchStopsAtItsLimitPlansBuiltStepByStepAreOfferedWith
   EXPECT_TRUE(plans.front().built);
 }
 
+// Two plans wanted, the exact search (forwards) stopped at once, `seed` offered; every plan
+// is accepted and its primitives recorded in order.
+SearchOptions stopped_with_seed(std::vector<int> seed, std::vector<std::vector<int>>& offered) {
+  SearchOptions options{2};
+  options.max_expansions = 1;
+  options.direction = SearchDirection::Forward;
+  options.seeds = {std::move(seed)};
+  options.accept = [&offered](const Plan& plan) {
+    offered.push_back(detail::sequence_of(plan));
+    return true;
+  };
+  return options;
+}
+
 // A sequence found elsewhere (the proof's replay, planner/core_proof.hpp) is judged with
 // the plans built step by step, and comes first among them.
 TEST(Search, WhenTheExactSearchStopsAtItsLimitASeedIsOfferedWithItsGap) {
   const VoxelProblem vp = block_and_cutters();
-  SearchOptions options{2};
-  options.max_expansions = 1;
-  options.direction = SearchDirection::Forward;
-  options.seeds = {{0, 4}};  // the block, milled by the finisher
   std::vector<std::vector<int>> offered;
-  options.accept = [&](const Plan& plan) {
-    std::vector<int> sequence;
-    for (const PlanStep& s : plan.steps) sequence.push_back(s.primitive);
-    offered.push_back(sequence);
-    return true;
-  };
+  const SearchOptions options = stopped_with_seed({0, 4}, offered);  // the block, milled by the finisher
   SearchStats stats;
   const auto plans = find_plans(vp.problem, options, &stats);
   ASSERT_EQ(plans.size(), 2u);
@@ -157,17 +162,8 @@ TEST(Search, ASeedIsTheCallersPlanWhenTheSearchLeavesPrimitivesOut) {
   std::vector<VoxelPrimitive> prims = base.primitives;
   prims.insert(prims.begin() + 1, {"spill", Mode::Additive, false, 0.5, box(0, 0, 10, 10)});
   const VoxelProblem vp = make_problem(std::move(prims), base.design, base.domain);
-  SearchOptions options{2};
-  options.max_expansions = 1;
-  options.direction = SearchDirection::Forward;
-  options.seeds = {{0, 5}};  // the block, milled by the finisher
   std::vector<std::vector<int>> offered;
-  options.accept = [&](const Plan& plan) {
-    std::vector<int> sequence;
-    for (const PlanStep& s : plan.steps) sequence.push_back(s.primitive);
-    offered.push_back(sequence);
-    return true;
-  };
+  const SearchOptions options = stopped_with_seed({0, 5}, offered);  // the block, milled by the finisher
   const auto plans = find_plans(vp.problem, options);
   ASSERT_FALSE(offered.empty());
   EXPECT_EQ(offered.front(), (std::vector<int>{0, 5}));
