@@ -437,9 +437,8 @@ CoreProof correct_by_replays(SearchOptions& search, std::int64_t max_rejected, L
   for (;;) {
     CoreProof corrected = prove_by_core(r.problem, quick_proof_limits());
     if (corrected.outcome != CoreProof::Outcome::Feasible) return corrected;
-    search.seeds = {corrected.sequence};
-    for (const StartProof& start : r.stock_starts)
-      if (start.proof.outcome == CoreProof::Outcome::Feasible) search.seeds.push_back(start.proof.sequence);
+    search.seeds = start_seeds(r.stock_starts);
+    search.seeds.insert(search.seeds.begin(), corrected.sequence);
     Plan replay;
     if (!search.accept || !detail::simulate(r.problem, corrected.sequence, replay) || !is_goal(r.problem, replay.final_state) ||
         std::int64_t(r.rejected.size()) >= max_rejected || r.search_rounds + r.replay_rounds >= kMaxLearningRounds)
@@ -468,8 +467,7 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
   search.known_to_fail = known_failure_hook(options, r);
   search.max_rejected = options.max_rejected;
   if (r.core_proof.outcome == CoreProof::Outcome::Feasible) search.seeds.push_back(r.core_proof.sequence);
-  for (const StartProof& s : r.stock_starts)
-    if (s.proof.outcome == CoreProof::Outcome::Feasible) search.seeds.push_back(s.proof.sequence);
+  for (std::vector<int>& seed : start_seeds(r.stock_starts)) search.seeds.push_back(std::move(seed));
   // A rejection that showed a primitive falling short stops the search: the next one runs
   // on the problem without what the primitive does not do (planner/shortfall.hpp).
   if (options.learn)

@@ -25,4 +25,11 @@ std::vector<StartProof> prove_stock_starts(PlanningProblem& problem, const CoreP
   return out;
 }
 
+std::vector<std::vector<int>> start_seeds(const std::vector<StartProof>& starts) {
+  std::vector<std::vector<int>> out;
+  for (const StartProof& s : starts)
+    if (s.proof.outcome == CoreProof::Outcome::Feasible) out.push_back(s.proof.sequence);
+  return out;
+}
+
 }  // namespace hybridctl::planner

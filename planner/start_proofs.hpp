@@ -33,4 +33,7 @@ struct StartProof {
 // one possible start (the proof of the whole problem is then the same).
 std::vector<StartProof> prove_stock_starts(PlanningProblem& problem, const CoreProofLimits& limits);
 
+// The plans the proofs replayed (stocks that start one), as the search's seeds.
+std::vector<std::vector<int>> start_seeds(const std::vector<StartProof>& starts);
+
 }  // namespace hybridctl::planner
