@@ -163,6 +163,13 @@ void LowerBound::index_lists() {
     remover_list_.push_back(id_of(removers_[std::size_t(a)]));
   }
   for (const std::vector<int>& list : last_adders()) last_adder_list_.push_back(id_of(list));
+  lays_some_last_.assign(p.primitives.size(), false);
+  last_list_.assign(lists_.size(), false);
+  for (int a = 0; a < atoms_; ++a)
+    if (p.atoms[std::size_t(a)].must_in) {
+      last_list_[std::size_t(last_adder_list_[std::size_t(a)])] = true;
+      for (int i : lists_[std::size_t(last_adder_list_[std::size_t(a)])]) lays_some_last_[std::size_t(i)] = true;
+    }
   // The lists, tools and setups as bit masks over the primitives.
   const std::size_t prim_words = (p.primitives.size() + 63) / 64;
   auto mask = [&](auto member) {
@@ -244,54 +251,134 @@ LowerBound::AtomShares LowerBound::atom_part(const AtomSet& state, const Rates& 
   return h;  // infinite when some needed atom has no supplier left
 }
 
+// Each must-in atom still to be laid (missing now, or cut by a removal to come) is laid last
+// by an adder under a rate threshold or by one at it or above. So a completion pays either
+// the side effects of some adder under the threshold that may lay a must-in atom last (the
+// waste an overfilling head lays with the design, laid and cut away), or, for each such
+// atom, the least rate at or above the threshold instead of the atom part's rate. Per
+// threshold (each rate of the adders that may lay design last, but the cheapest): the
+// cheaper side effect, and per last-adder list what its atoms cost beyond its rate.
+std::vector<LowerBound::Relay> LowerBound::relays(const Rates& r, const std::vector<double>& side) const {
+  std::vector<double> thresholds;
+  for (std::size_t i = 0; i < p_.primitives.size(); ++i)
+    if (r.allowed[i] && lays_some_last_[i]) thresholds.push_back(p_.primitives[i].cost_per_mm3);
+  std::sort(thresholds.begin(), thresholds.end());
+  thresholds.erase(std::unique(thresholds.begin(), thresholds.end()), thresholds.end());
+  std::vector<Relay> out;
+  for (std::size_t k = 1; k < thresholds.size(); ++k) {
+    const double threshold = thresholds[k];
+    Relay relay;
+    relay.cheap_side = kInfinity;
+    for (std::size_t i = 0; i < p_.primitives.size(); ++i) {
+      const PrimitiveSpec& prim = p_.primitives[i];
+      if (!r.allowed[i] || !lays_some_last_[i] || prim.cost_per_mm3 >= threshold) continue;
+      // One that falls short may lay less than its side effects: nothing is sure.
+      relay.cheap_side = std::min(relay.cheap_side, prim.falls_short.words().empty() ? side[i] : 0.0);
+    }
+    if (relay.cheap_side <= 0) continue;
+    relay.extra.assign(lists_.size(), 0);
+    for (std::size_t l = 0; l < lists_.size(); ++l) {
+      if (!last_list_[l] || r.rate[l] >= threshold) continue;
+      double at_threshold = kInfinity;  // lists are cheapest first
+      for (int i : lists_[l])
+        if (r.allowed[std::size_t(i)] && p_.primitives[std::size_t(i)].cost_per_mm3 >= threshold) {
+          at_threshold = p_.primitives[std::size_t(i)].cost_per_mm3;
+          break;
+        }
+      relay.extra[l] = at_threshold - r.rate[l];
+    }
+    out.push_back(std::move(relay));
+  }
+  return out;
+}
+
 // A completion removes every must-out atom present, and a removal that cuts design present
 // (or design a removal before it cut) is followed by a deposit of that design. Let r* be
 // the used removal whose design share R (the design present in it, at the cheapest rates
-// that deposit it) is largest: the completion pays at least R(r*) for deposits, and removes
-// each must-out atom present with one of the removals whose R is at most R(r*). So the
-// least over thresholds t of t + (each must-out atom present at the cheapest rate of a
-// removal with R <= t) bounds this share; t = 0 are the removals that spare the design.
+// that deposit it last) is largest: the completion pays at least R(r*) for deposits, and
+// removes each must-out atom present with one of the removals whose R is at most R(r*).
+// So the least over thresholds t of t + (each must-out atom present at the cheapest rate of
+// a removal with R <= t) bounds this share; t = 0 are the removals that spare the design.
 // It never falls by more than a removal costs plus the design it cuts (which the atom
 // part's deposits then charge): the threshold that covers the removal taken does as well
 // before it.
-double LowerBound::removals_with_design_cut(const AtomSet& state, const Rates& r) const {
+// `relaid` adds, per threshold, what laying last the design r* cuts and the design missing
+// costs beyond those rates (relays): the least over the removals of that threshold. It
+// bounds everything but the atom part's deposits and the fixed costs, side effects
+// included, so it stands beside the sum of the other shares, not in it.
+LowerBound::DesignCut LowerBound::removals_with_design_cut(const AtomSet& state, const Rates& r,
+                                                           const std::vector<double>& side,
+                                                           double cheapest_removals) const {
   const auto& s = state.words();
+  const std::vector<Relay> relay = relays(r, side);
+  const std::size_t kinds = relay.size();
   // Each allowed removal's design share in this state: a must-in atom present is cut by
   // exactly the removals of its remover list, so its price is summed per list once.
-  std::vector<double> per_list(lists_.size(), 0);
-  for (std::size_t w = 0; w < s.size(); ++w)
+  std::vector<double> per_list(lists_.size(), 0), missing_extra(kinds, 0);
+  std::vector<std::vector<double>> extra_per_list(kinds, std::vector<double>(kinds ? lists_.size() : 0, 0));
+  for (std::size_t w = 0; w < s.size(); ++w) {
     for (std::uint64_t b = s[w] & must_in_[w]; b; b &= b - 1) {
       const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
       per_list[std::size_t(remover_list_[a])] += r.last_deposit(a) * p_.atoms[a].volume;
+      for (std::size_t k = 0; k < kinds; ++k)
+        if (const double e = relay[k].extra[std::size_t(last_adder_list_[a])]; e > 0)
+          extra_per_list[k][std::size_t(remover_list_[a])] += e * p_.atoms[a].volume;
     }
+    for (std::uint64_t b = must_in_[w] & ~s[w]; b; b &= b - 1) {
+      const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
+      for (std::size_t k = 0; k < kinds; ++k)
+        if (const double e = relay[k].extra[std::size_t(last_adder_list_[a])]; e > 0) missing_extra[k] += e * p_.atoms[a].volume;
+    }
+  }
   const std::vector<double> cut_share = per_primitive(per_list);
-  std::vector<std::pair<double, int>> shares;
+  std::vector<std::vector<double>> cut_extra;
+  for (const auto& e : extra_per_list) cut_extra.push_back(per_primitive(e));
+  struct Cut {
+    double share;
+    int removal;
+  };
+  std::vector<Cut> cuts;
   for (std::size_t i = 0; i < p_.primitives.size(); ++i) {
     const PrimitiveSpec& prim = p_.primitives[i];
     if (prim.mode != Mode::Subtractive || !r.allowed[i]) continue;
-    double share = cut_share[i];
+    Cut cut{cut_share[i], int(i)};
     if (!prim.falls_short.words().empty()) {  // not what it was seen not to cut
       const auto& pa = prim.atoms.words();
       const auto& short_of = prim.falls_short.words();
-      share = 0;
+      cut.share = 0;
+      for (auto& e : cut_extra) e[i] = 0;
       for (std::size_t w = 0; w < s.size(); ++w) {
-        const std::uint64_t cut = pa[w] & s[w] & must_in_[w] & ~(w < short_of.size() ? short_of[w] : 0);
-        for (std::uint64_t b = cut; b; b &= b - 1) {
+        const std::uint64_t cutting = pa[w] & s[w] & must_in_[w] & ~(w < short_of.size() ? short_of[w] : 0);
+        for (std::uint64_t b = cutting; b; b &= b - 1) {
           const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
-          share += r.last_deposit(a) * p_.atoms[a].volume;
+          cut.share += r.last_deposit(a) * p_.atoms[a].volume;
+          for (std::size_t k = 0; k < kinds; ++k)
+            cut_extra[k][i] += relay[k].extra[std::size_t(last_adder_list_[a])] * p_.atoms[a].volume;
         }
       }
     }
-    shares.emplace_back(share, int(i));
+    cuts.push_back(cut);
   }
-  std::sort(shares.begin(), shares.end());
-  if (shares.empty() || shares.back().first == 0) return 0;  // no removal cuts design: the atom part prices it
+  std::sort(cuts.begin(), cuts.end(), [](const Cut& x, const Cut& y) { return x.share < y.share; });
+  // What missing design costs beyond the atom part with no design laid again (threshold 0).
+  double missing_relaid = 0;
+  for (std::size_t n = 0; n < kinds; ++n) missing_relaid = std::max(missing_relaid, std::min(relay[n].cheap_side, missing_extra[n]));
+  // No removal cuts design: each must-out atom at its cheapest removal (the atom part's).
+  if (cuts.empty() || cuts.back().share == 0) return {cheapest_removals, cheapest_removals + missing_relaid};
   // Thresholds: 0 and each distinct share; per removal the first threshold admitting it.
+  // At 0 nothing need be laid again: no removal may be used at all.
   std::vector<double> threshold{0.0};
+  std::vector<std::vector<double>> least_extra(kinds, std::vector<double>{0.0});
   std::vector<int> rank(p_.primitives.size(), -1);
-  for (const auto& [share, i] : shares) {
-    if (share > threshold.back()) threshold.push_back(share);
-    rank[std::size_t(i)] = int(threshold.size()) - 1;
+  for (const Cut& cut : cuts) {
+    if (cut.share > threshold.back()) {
+      threshold.push_back(cut.share);
+      for (auto& l : least_extra) l.push_back(kInfinity);
+    }
+    rank[std::size_t(cut.removal)] = int(threshold.size()) - 1;
+    if (threshold.size() > 1)
+      for (std::size_t k = 0; k < kinds; ++k)
+        least_extra[k].back() = std::min(least_extra[k].back(), cut_extra[k][std::size_t(cut.removal)]);
   }
   const std::size_t k = threshold.size();
   // The must-out volume present per remover list: atoms of one list price alike.
@@ -317,13 +404,19 @@ double LowerBound::removals_with_design_cut(const AtomSet& state, const Rates& r
       step[std::size_t(lowest)] -= price;
       lowest = j;
     }
-    if (lowest == int(k)) return kInfinity;  // no removal left for these atoms
+    if (lowest == int(k)) return {kInfinity, kInfinity};  // no removal left for these atoms
     priced_from = std::max(priced_from, std::size_t(lowest));  // below it they cannot go
   }
-  double best = kInfinity, total = 0;
+  DesignCut best{kInfinity, kInfinity};
+  double total = 0;
   for (std::size_t j = 0; j < k; ++j) {
     total += step[j];
-    if (j >= priced_from) best = std::min(best, threshold[j] + total);
+    if (j < priced_from) continue;
+    best.plain = std::min(best.plain, threshold[j] + total);
+    double relaid = 0;
+    for (std::size_t n = 0; n < kinds; ++n)
+      relaid = std::max(relaid, std::min(relay[n].cheap_side, missing_extra[n] + least_extra[n][j]));
+    best.relaid = std::min(best.relaid, threshold[j] + total + relaid);
   }
   return best;
 }
@@ -357,7 +450,7 @@ LowerBound::SideShares LowerBound::side_effects(const AtomSet& state, const Rate
       per_list[l] += atom.volume * (rate[l] + (atom.must_in ? rate[std::size_t(adder_list_[a])] : 0));
     }
   }
-  const std::vector<double> side = per_primitive(per_list);
+  std::vector<double> side = per_primitive(per_list);
   const std::vector<char> needed = needed_lists(state);
   // Per list, the volume of its atoms that are wrong: the first of its suppliers a
   // completion uses changes all of them (no other primitive holds them), at its own rate.
@@ -401,7 +494,7 @@ LowerBound::SideShares LowerBound::side_effects(const AtomSet& state, const Rate
     const bool adds = p_.primitives[std::size_t(lists_[l].front())].mode == Mode::Additive;
     (adds ? add : remove) = std::max(adds ? add : remove, least(l));
   }
-  return {add, remove};
+  return {add, remove, std::move(side)};
 }
 
 // The tools and setups some needed atom of `state` can only be changed with.
@@ -493,11 +586,12 @@ double LowerBound::operator()(const AtomSet& state, const std::vector<std::uint8
   const SideShares side = side_effects(state, r);
   if (side.deposits + side.removals == kInfinity) return kInfinity;
   // Removing what is present (and depositing again the design a removal cuts) is one share,
-  // bounded two ways: the larger counts.
-  // With no waste present (the atom part's removals are 0) there is nothing to price.
-  const double removals =
-      std::max(atoms.removals + side.removals, atoms.removals > 0 ? removals_with_design_cut(state, r) : 0.0);
-  return (atoms.deposits + side.deposits + removals + fixed_part(state, r, last)) / p_.normaliser;
+  // bounded two ways: the larger counts. The design cut with what laying design last costs
+  // beyond the atom part bounds that share and the side effects together.
+  const DesignCut cut = removals_with_design_cut(state, r, side.of, atoms.removals);
+  const double removals = std::max(atoms.removals + side.removals, cut.plain);
+  const double rest = std::max(side.deposits + removals, cut.relaid);
+  return (atoms.deposits + rest + fixed_part(state, r, last)) / p_.normaliser;
 }
 
 }  // namespace hybridctl::planner

@@ -15,6 +15,13 @@
 //    deposit of it, so each must-out atom present is priced among the removals whose
 //    design share is at most a threshold, plus the threshold, least over thresholds (this
 //    and the removal parts of the two above bound one share: the larger counts);
+//  - design laid again (relays, beside the sum of the two shares above and the side
+//    effects, not in it): each must-in atom missing, and the design the dearest removal
+//    cuts, is laid last either by an adder under a rate threshold, whose use lays its
+//    side effects (an overfilling head's waste, absent now, laid and cut again), or by
+//    one at or above it: the cheaper of the two counts (a ring on a plate milled from a
+//    block: each removal that clears the bore cuts part of the ring, laid again at the
+//    exact head's rate or with the wire-arc's overfill);
 //  - fixed costs: a mode switch when the other mode is still needed (two when every
 //    additive primitive left holds a must-out atom and the plan is removing now), a tool
 //    change per tool that some atom can only be changed by, other than the current one,
@@ -72,10 +79,27 @@ class LowerBound {
   struct AtomShares {
     double deposits = 0, removals = 0;
   };
-  using SideShares = AtomShares;
+  struct SideShares {
+    double deposits = 0, removals = 0;
+    std::vector<double> of;  // per primitive: what using it costs beyond the atom part
+  };
   AtomShares atom_part(const AtomSet& state, const Rates& r) const;
   SideShares side_effects(const AtomSet& state, const Rates& r) const;
-  double removals_with_design_cut(const AtomSet& state, const Rates& r) const;
+  // Per rate threshold: what laying must-in atoms last costs beyond the atom part's rate
+  // (planner/search_bound.cpp: relays).
+  struct Relay {
+    double cheap_side = 0;      // the least side effect of an adder under the threshold
+    std::vector<double> extra;  // per last-adder list, per mm³
+  };
+  std::vector<Relay> relays(const Rates& r, const std::vector<double>& side) const;
+  // The removals' share two ways: with the design they cut at the atom part's rates, and
+  // with what laying that design and the missing design last costs beyond them.
+  // `cheapest_removals`: the atom part's removals (each must-out atom at its cheapest).
+  struct DesignCut {
+    double plain = 0, relaid = 0;
+  };
+  DesignCut removals_with_design_cut(const AtomSet& state, const Rates& r, const std::vector<double>& side,
+                                     double cheapest_removals) const;
   double fixed_part(const AtomSet& state, const Rates& r, int last) const;
   void index_lists();
   void force(const AtomSet& state, const Rates& r, std::vector<bool>& tool_forced, std::vector<bool>& setup_forced) const;
@@ -91,6 +115,8 @@ class LowerBound {
   std::vector<int> adder_list_, remover_list_;
   // Per atom its list of the adders that can lay it last (planner/search_bound.cpp).
   std::vector<int> last_adder_list_;
+  std::vector<bool> lays_some_last_;  // per primitive: on some must-in atom's last-adder list
+  std::vector<bool> last_list_;       // per list: some must-in atom's last-adder list
   std::vector<std::vector<int>> last_adders() const;
   // Per list the rate of its first (cheapest) member, and per primitive the lists it comes
   // first in: [0] with every primitive allowed, [1] with the raw stocks left out, as they

@@ -484,6 +484,40 @@ TEST(Search, TheBoundChargesDesignAtTheRateOfWhatMayLayItLast) {
   EXPECT_DOUBLE_EQ(find_plans(vp.problem, {1}).front().cost, optimum);
 }
 
+// A block whose waste each removal clears only by cutting part of the design (the bushing's
+// bore): that part is laid again, by the overfilling head C only if its waste, absent now,
+// is laid and cut too, or else by the exact head D. Per atom, some removal spares each
+// design atom, so C may lay any of it last; the bound charges the cheaper of C's side
+// effects and D's rate beyond C's on the design a removal cuts. On a 4 x 3 grid: design
+// row y = 0, stock S rows 0-1 (waste row 1), C rows 0-2 (waste rows 1-2), R1 and R2 clear
+// rows 1-2 and the design's left or right half.
+TEST(Search, TheBoundChargesDesignCutAndLaidAgainAtTheDearerHeadOrTheCheapOnesWaste) {
+  std::vector<VoxelPrimitive> prims = {
+      {"S", Mode::Additive, true, 0.0, rect(0, 0, 4, 2)},
+      {"C", Mode::Additive, false, 1.0, rect(0, 0, 4, 3)},
+      {"D", Mode::Additive, false, 5.0, rect(0, 0, 4, 1)},
+      {"R1", Mode::Subtractive, false, 1.0, unite(rect(0, 1, 4, 3), rect(0, 0, 2, 1))},
+      {"R2", Mode::Subtractive, false, 1.0, unite(rect(0, 1, 4, 3), rect(2, 0, 4, 1))},
+  };
+  const VoxelProblem vp = make_problem(std::move(prims), rect(0, 0, 4, 1), {{0, 0, 0}, {4, 3, 1}});
+  const LowerBound bound(vp.problem);
+  for (int a = 0; a < int(vp.problem.atoms.size()); ++a)
+    if (vp.problem.atoms[std::size_t(a)].must_in) EXPECT_TRUE(bound.lays_last(1, a));
+  // After S: its waste row costs 4 to remove, the removal cuts 2 cells of design, laid
+  // again at C's rate 1 at least; and then either C's absent row of waste is laid and
+  // removed (4 x (1 + 1)) or the 2 cells cost D's 5, 4 more each: 2 + 4 + 8. The best
+  // completion: R1 (6), D (2 x 5).
+  const AtomSet after_stock = vp.problem.primitives[0].atoms;
+  std::vector<std::uint8_t> uses(5, 0);
+  uses[0] = 1;
+  const double h = bound(after_stock, uses, 0);
+  EXPECT_GE(h * vp.problem.normaliser, 14 - 1e-9);
+  EXPECT_LE(h * vp.problem.normaliser, 16 + 1e-9);
+  const double optimum = enumerate_plans(vp.problem, 1).front().cost;
+  EXPECT_NEAR(optimum * vp.problem.normaliser, 16, 1e-9);
+  EXPECT_DOUBLE_EQ(find_plans(vp.problem, {1}).front().cost, optimum);
+}
+
 // Stopped early, the search still answers: plans from weighted A*, each with a gap that
 // holds against the true optimum, and a lower bound that does not exceed it.
 TEST(Search, StoppedEarlyItReturnsPlansWithAProvenGap) {
