@@ -103,13 +103,32 @@ void rasterise(RowMask& mask, std::span<const ConvexPiece> pieces, std::span<con
     }
   mask.reset(all);
   const IndexBox stored = only_over ? only_over->storage_box() : IndexBox{};
-  for (const Job& job : jobs)
-    for (int z = job.box.lo.z; z < job.box.hi.z; ++z)
-      for (int y = job.box.lo.y; y < job.box.hi.y; ++y) {
-        if (only_over && !row_has_material(*only_over, stored, y, z, job.box.lo.x, job.box.hi.x)) continue;
-        const XRange r = job.sweep.row(y, z);
+  // A cylinder moved level (a pocket's passes, most of a milling program) or along its
+  // axis sweeps the same interval of a row at every height inside its bounds: worked out
+  // once per y, on the first height that needs it, instead of once per row.
+  std::vector<XRange> per_y;
+  std::vector<char> known;
+  for (const Job& job : jobs) {
+    const IndexBox& b = job.box;
+    const bool alike = job.sweep.alike_in_height() && b.hi.z - b.lo.z > 2;
+    if (alike) {
+      per_y.assign(std::size_t(b.hi.y - b.lo.y), XRange{});
+      known.assign(per_y.size(), 0);
+    }
+    for (int z = b.lo.z; z < b.hi.z; ++z)
+      for (int y = b.lo.y; y < b.hi.y; ++y) {
+        if (only_over && !row_has_material(*only_over, stored, y, z, b.lo.x, b.hi.x)) continue;
+        XRange r;
+        if (alike && z > b.lo.z && z < b.hi.z - 1) {
+          const std::size_t k = std::size_t(y - b.lo.y);
+          if (!known[k]) per_y[k] = job.sweep.row(y, z), known[k] = 1;
+          r = per_y[k];
+        } else {
+          r = job.sweep.row(y, z);
+        }
         if (!r.empty()) mask.add(y, z, r.x0, r.x1);
       }
+  }
 }
 
 // The sweep over `stock` alone, for masks only ever intersected with it (a cut, a collision

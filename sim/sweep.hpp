@@ -83,6 +83,10 @@ class PieceSweep {
   geometry::IndexBox bounds(const geometry::IndexBox& clip = {}) const;
   // The swept voxels of row (y, z).
   XRange row(int y, int z) const;
+  // Whether row(y, z) is one interval per y at every height the slab covers: a cylinder
+  // moved level or straight along its axis. Only the bounds' first and last heights,
+  // where the slab's edge falls, may differ from the rest.
+  bool alike_in_height() const { return piece_.kind == ConvexPiece::Kind::Cylinder && (level_ || vertical_); }
 
  private:
   bool torus_contains(double x, double y, double z, double ta, double tb) const;

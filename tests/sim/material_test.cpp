@@ -143,6 +143,27 @@ TEST(MaterialSimulation, ACutRemovesExactlyTheSweptVolumeOfTheCuttingPart) {
   }
 }
 
+// A cylinder moved level or along its axis sweeps one interval per y at every height
+// inside its slab, which the simulation works out once per y: the cut is still exactly
+// the swept volume, slab edges on a decimal lattice included (and a ramp, row by row).
+TEST(MaterialSimulation, AFlatMillMovedLevelOrPlungedRemovesExactlyItsSweptVolume) {
+  const geometry::Lattice decimal{0.1, {0, 0, 0}};
+  const IndexBox box{{0, 0, 0}, {60, 60, 40}};
+  const Cutter flat = cutter_of(tool(config::ToolType::Flat, 1.3, 1.7, {1.3, 2.5}));
+  for (const auto& [a, b] : std::vector<std::pair<Vec3, Vec3>>{{{0.55, 1.05, 1.25}, {4.85, 3.3, 1.25}},
+                                                                {{3.0, 3.0, 0.35}, {3.0, 3.0, 0.35}},
+                                                                {{2.05, 2.95, 3.45}, {2.05, 2.95, 0.25}},
+                                                                {{1.0, 4.4, 0.15}, {1.0, 4.4, 2.65}},
+                                                                {{5.0, 0.8, 2.0}, {0.9, 0.8, 2.0}},
+                                                                {{0.7, 0.9, 0.3}, {4.6, 4.1, 2.9}}}) {  // a ramp
+    MaterialSimulation sim(Solid::filled(decimal, box));
+    sim.cut(flat, feed(a, b, 1));
+    const Solid swept = swept_volume(pieces_of(flat.cutting), {a, b}, decimal, box);
+    EXPECT_GT(swept.volume(), 0);
+    EXPECT_EQ(removed(Solid::filled(decimal, box), sim), swept);
+  }
+}
+
 TEST(MaterialSimulation, ARapidIntoMaterialRaisesAnIncidentNamingTheLine) {
   const Cutter mill = cutter_of(tool(config::ToolType::Flat, 4, 8, {4, 8}));
   MaterialSimulation sim(full_stock());
