@@ -352,6 +352,7 @@ MoveReport MaterialSimulation::cut(const Cutter& cutter, const MaterialMove& mov
     touch();
   }
 
+  if (removed.voxels > 0) shrink_material_box({removed.lo, {removed.hi.x + 1, removed.hi.y + 1, removed.hi.z + 1}});
   const double v = stock_.voxel_size() * stock_.voxel_size() * stock_.voxel_size();
   MoveReport out;
   out.removed = double(removed.voxels) * v;
@@ -370,6 +371,36 @@ MoveReport MaterialSimulation::cut(const Cutter& cutter, const MaterialMove& mov
   incident(IncidentKind::Gouge, gouge);
   finish(move, out);
   return out;
+}
+
+void MaterialSimulation::shrink_material_box(const IndexBox& removed) {
+  IndexBox& b = material_box_;
+  const IndexBox stored = stock_.storage_box();
+  // Whether the box's voxels with coordinate `axis` at `at` hold no material.
+  auto empty_layer = [&](int axis, int at) {
+    if (axis == 2) {
+      for (int y = b.lo.y; y < b.hi.y; ++y)
+        if (row_has_material(stock_, stored, y, at, b.lo.x, b.hi.x)) return false;
+    } else if (axis == 1) {
+      for (int z = b.lo.z; z < b.hi.z; ++z)
+        if (row_has_material(stock_, stored, at, z, b.lo.x, b.hi.x)) return false;
+    } else {
+      for (int z = b.lo.z; z < b.hi.z; ++z)
+        for (int y = b.lo.y; y < b.hi.y; ++y)
+          if (stock_.contains({at, y, z})) return false;
+    }
+    return true;
+  };
+  auto lo = [](IndexBox& box, int axis) -> int& { return axis == 0 ? box.lo.x : axis == 1 ? box.lo.y : box.lo.z; };
+  auto hi = [](IndexBox& box, int axis) -> int& { return axis == 0 ? box.hi.x : axis == 1 ? box.hi.y : box.hi.z; };
+  IndexBox cut = removed;
+  for (int axis = 2; axis >= 0 && !b.empty(); --axis) {
+    if (lo(cut, axis) <= lo(b, axis))
+      while (lo(b, axis) < hi(b, axis) && empty_layer(axis, lo(b, axis))) ++lo(b, axis);
+    if (hi(cut, axis) >= hi(b, axis))
+      while (hi(b, axis) > lo(b, axis) && empty_layer(axis, hi(b, axis) - 1)) --hi(b, axis);
+  }
+  if (b.empty()) b = {};
 }
 
 MoveReport MaterialSimulation::deposit(const Bead& bead, const MaterialMove& move) {

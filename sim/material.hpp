@@ -110,9 +110,14 @@ class MaterialSimulation {
   // empty, the first bead's lowest layer (docs/support.md, "In the simulator").
   int plate_ = 0;
   bool empty_ = true;  // no material in the stock yet
-  // A box holding all material of the stock: cuts leave it as it is, deposits grow it.
-  // Sweeps tested against material are clipped to it (most of a holder sweeps air).
+  // A box holding all material of the stock: deposits grow it, and a cut that empties a
+  // face layer moves that face in (shrink_material_box). Sweeps tested against material
+  // are clipped to it: most of a holder sweeps air, and a tool working down level by
+  // level sweeps its shank and holder through the air above the material.
   geometry::IndexBox material_box_;
+  // After a cut that removed voxels within `removed`: each face of the box in it moves in
+  // while its layer holds no material.
+  void shrink_material_box(const geometry::IndexBox& removed);
   // Reused scratch words for one move's swept voxels (instrument, body).
   std::vector<std::uint64_t> scratch_[2];
 };

@@ -164,6 +164,27 @@ TEST(MaterialSimulation, AFlatMillMovedLevelOrPlungedRemovesExactlyItsSweptVolum
   }
 }
 
+// The box the sweeps are clipped to shrinks as cuts empty its top layers (a tool working
+// down level by level sweeps its holder through air): what remains is still met, by the
+// holder one voxel layer below the cut and by a rapid, and a bead laid on top again.
+TEST(MaterialSimulation, AfterCutsClearTheTopWhatRemainsAndWhatIsLaidAgainAreStillMet) {
+  const Cutter mill = cutter_of(tool(config::ToolType::Flat, 4, 2, {4, 3}, {30, 40}));  // holder from 5 mm up
+  MaterialSimulation sim(full_stock());
+  for (int pass = 0; pass <= 6; ++pass) {  // the top 2 mm cleared: voxel centres 8 mm and up
+    const double y = -1.5 + 3.5 * pass;
+    sim.cut(mill, feed({-3, y, 8}, {23, y, 8}, 10 + pass));
+  }
+  EXPECT_EQ(sim.stock().bounding_box().hi.z, 16);  // centres up to 7.5 mm remain
+  EXPECT_TRUE(sim.cut(mill, rapid({10, 10, 30}, {10, 10, 8.1}, 20)).incidents.empty());
+  EXPECT_EQ(count_of(sim.cut(mill, rapid({10, 10, 8.1}, {10, 10, 7.4}, 21)).incidents, IncidentKind::RapidIntoMaterial), 1);
+  // The holder's face at 2.4 + 5 mm reaches the centres at 7.5 mm; at 2.6 + 5 it does not.
+  EXPECT_EQ(count_of(sim.cut(mill, feed({-10, 10, 2.6}, {-3, 10, 2.6}, 22)).incidents, IncidentKind::BodyCollision), 0);
+  EXPECT_EQ(count_of(sim.cut(mill, feed({-10, 10, 2.4}, {-3, 10, 2.4}, 23)).incidents, IncidentKind::BodyCollision), 1);
+  const Bead bead{config::BeadShape::Cylinder, 2, 1, {}, {}};
+  EXPECT_GT(sim.deposit(bead, {Motion::Linear, {5, 5, 8}, {15, 5, 8}, {}, true, 24}).deposited, 0);
+  EXPECT_EQ(count_of(sim.cut(mill, rapid({10, 5, 30}, {10, 5, 8.6}, 25)).incidents, IncidentKind::RapidIntoMaterial), 1);
+}
+
 TEST(MaterialSimulation, ARapidIntoMaterialRaisesAnIncidentNamingTheLine) {
   const Cutter mill = cutter_of(tool(config::ToolType::Flat, 4, 8, {4, 8}));
   MaterialSimulation sim(full_stock());
