@@ -78,21 +78,17 @@ bool row_has_material(const geometry::Solid& stock, const IndexBox& d, int y, in
   return any != 0;
 }
 
-// Rasterises the sweep of `pieces` along every segment into `mask` (the union), over the
-// swept bounds intersected with `clip` (empty: unclipped, finite pieces only).
-// `only_over`, when given: the mask is only ever intersected with this stock as it is now
-// or with less of it (a cut, a collision test), so rows where it holds no material near
-// the sweep are left empty instead of computed. Most of a holder's and a nozzle's body
-// sweeps air: this is what keeps their tests cheap.
-void rasterise(RowMask& mask, std::span<const ConvexPiece> pieces, std::span<const Segment> segments,
-               const geometry::Lattice& lattice, const IndexBox& clip, const geometry::Solid* only_over = nullptr) {
-  struct Job {
-    PieceSweep sweep;
-    IndexBox box;
-  };
-  std::vector<Job> jobs;
+// The sweep of `pieces` along every segment, one job per piece and segment, each with the
+// voxels it may sweep within `clip` (empty: unclipped, finite pieces only).
+struct SweepJob {
+  PieceSweep sweep;
+  IndexBox box;
+};
+std::vector<SweepJob> sweep_jobs(std::span<const ConvexPiece> pieces, std::span<const Segment> segments,
+                                 const geometry::Lattice& lattice, const IndexBox& clip, IndexBox& all) {
+  std::vector<SweepJob> jobs;
   jobs.reserve(pieces.size() * segments.size());
-  IndexBox all;
+  all = {};
   for (const Segment& s : segments)
     for (const ConvexPiece& p : pieces) {
       PieceSweep sweep(p, s, lattice);
@@ -101,14 +97,24 @@ void rasterise(RowMask& mask, std::span<const ConvexPiece> pieces, std::span<con
       all = all.empty() ? box : geometry::box_union(all, box);
       jobs.push_back({sweep, box});
     }
-  mask.reset(all);
+  return jobs;
+}
+
+// Calls row(y, z, x0, x1) for every row's swept voxels [x0, x1) of the jobs, within their
+// boxes (a row swept by several jobs comes once per job).
+// `only_over`, when given: what is swept only ever meets this stock as it is now or with
+// less of it (a cut, a collision test), so rows where it holds no material near the sweep
+// are skipped instead of computed. Most of a holder's and a nozzle's body sweeps air:
+// this is what keeps their tests cheap.
+template <class RowFn>
+void for_each_swept_row(std::span<const SweepJob> jobs, const geometry::Solid* only_over, RowFn&& row) {
   const IndexBox stored = only_over ? only_over->storage_box() : IndexBox{};
   // A cylinder moved level (a pocket's passes, most of a milling program) or along its
   // axis sweeps the same interval of a row at every height inside its bounds: worked out
   // once per y, on the first height that needs it, instead of once per row.
   std::vector<XRange> per_y;
   std::vector<char> known;
-  for (const Job& job : jobs) {
+  for (const SweepJob& job : jobs) {
     const IndexBox& b = job.box;
     const bool alike = job.sweep.alike_in_height() && b.hi.z - b.lo.z > 2;
     if (alike) {
@@ -126,17 +132,35 @@ void rasterise(RowMask& mask, std::span<const ConvexPiece> pieces, std::span<con
         } else {
           r = job.sweep.row(y, z);
         }
-        if (!r.empty()) mask.add(y, z, r.x0, r.x1);
+        r.x0 = std::max(r.x0, b.lo.x);
+        r.x1 = std::min(r.x1, b.hi.x);
+        if (!r.empty()) row(y, z, r.x0, r.x1);
       }
   }
 }
 
-// The sweep over `stock` alone, for masks only ever intersected with it (a cut, a collision
-// test): clipped to the box its material lies in (`material`, a box holding it) and to
-// its rows with material (rasterise's only_over).
+// Rasterises the sweep of `pieces` along every segment into `mask` (the union), over the
+// swept bounds intersected with `clip` (empty: unclipped, finite pieces only); `only_over`
+// as for_each_swept_row's.
+void rasterise(RowMask& mask, std::span<const ConvexPiece> pieces, std::span<const Segment> segments,
+               const geometry::Lattice& lattice, const IndexBox& clip, const geometry::Solid* only_over = nullptr) {
+  IndexBox all;
+  const std::vector<SweepJob> jobs = sweep_jobs(pieces, segments, lattice, clip, all);
+  mask.reset(all);
+  for_each_swept_row(jobs, only_over, [&](int y, int z, int x0, int x1) { mask.add(y, z, x0, x1); });
+}
+
+// The part of the domain a sweep over `stock` alone need look at: the box its material
+// lies in (`material`, a box holding it), within its storage.
+IndexBox over_material(const geometry::Solid& stock, const IndexBox& material) {
+  return geometry::box_intersection(stock.storage_box(), material);
+}
+
+// The sweep over `stock` alone, for masks only ever intersected with it (a collision
+// test): clipped to the box its material lies in and to its rows with material.
 void rasterise_over(RowMask& mask, std::span<const ConvexPiece> pieces, std::span<const Segment> segments,
                     const geometry::Solid& stock, const IndexBox& material) {
-  const IndexBox clip = geometry::box_intersection(stock.storage_box(), material);
+  const IndexBox clip = over_material(stock, material);
   if (clip.empty())
     mask.reset({});
   else
@@ -322,23 +346,34 @@ MoveReport MaterialSimulation::cut(const Cutter& cutter, const MaterialMove& mov
   const std::vector<Segment> segments = path_segments(move, chord_tolerance());
   const std::vector<ConvexPiece> cutting = pieces_of(cutter.cutting), body = pieces_of(cutter.body);
   const geometry::Lattice& lattice = stock_.lattice();
-  RowMask cut_mask(scratch_[0]), body_mask(scratch_[1]);
-  rasterise_over(cut_mask, cutting, segments, stock_, material_box_);
-  rasterise_over(body_mask, body, segments, stock_, material_box_);
 
   const bool rapid = move.motion == Motion::Rapid;
   Tally removed, gouge, contact;
+  // The cutting part's sweep is cut from the stock row by row as it is worked out: no
+  // mask, and a row another piece of the cutter already cleared is skipped.
   auto remove = [&] {
-    for_each_word(cut_mask, stock_, false, [&](int y, int z, int w, std::uint64_t m, std::uint64_t& s) {
-      const std::uint64_t hit = s & m;
-      if (!hit) return;
-      removed.add(hit, w, y, z);
-      if (protected_) gouge.add(hit & protected_->word_at(w, y, z), w, y, z);
-      if (rapid) contact.add(hit, w, y, z);
-      s &= ~m;
+    const IndexBox clip = over_material(stock_, material_box_);
+    if (clip.empty()) return;
+    IndexBox all;
+    const std::vector<SweepJob> jobs = sweep_jobs(cutting, segments, lattice, clip, all);
+    const int first = stock_.first_word();
+    for_each_swept_row(jobs, &stock_, [&](int y, int z, int x0, int x1) {
+      std::uint64_t* s = stock_.row(y, z).data() - first;
+      const int wa = word_of(x0), wb = word_of(x1 - 1);
+      for (int w = wa; w <= wb; ++w) {
+        const std::uint64_t m = bit_range(w == wa ? x0 - w * kWordBits : 0, w == wb ? x1 - w * kWordBits : kWordBits);
+        const std::uint64_t hit = s[w] & m;
+        if (!hit) continue;
+        removed.add(hit, w, y, z);
+        if (protected_) gouge.add(hit & protected_->word_at(w, y, z), w, y, z);
+        if (rapid) contact.add(hit, w, y, z);
+        s[w] &= ~m;
+      }
     });
   };
+  RowMask body_mask(scratch_[1]);
   auto touch = [&] {
+    rasterise_over(body_mask, body, segments, stock_, material_box_);
     for_each_word(body_mask, stock_, false,
                   [&](int y, int z, int w, std::uint64_t m, std::uint64_t& s) { contact.add(s & m, w, y, z); });
   };
