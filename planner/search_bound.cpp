@@ -164,12 +164,18 @@ void LowerBound::index_lists() {
   }
   for (const std::vector<int>& list : last_adders()) last_adder_list_.push_back(id_of(list));
   lays_some_last_.assign(p.primitives.size(), false);
-  last_list_.assign(lists_.size(), false);
+  std::vector<bool> last_list(lists_.size(), false);
   for (int a = 0; a < atoms_; ++a)
     if (p.atoms[std::size_t(a)].must_in) {
-      last_list_[std::size_t(last_adder_list_[std::size_t(a)])] = true;
+      last_list[std::size_t(last_adder_list_[std::size_t(a)])] = true;
       for (int i : lists_[std::size_t(last_adder_list_[std::size_t(a)])]) lays_some_last_[std::size_t(i)] = true;
     }
+  for (std::size_t l = 0; l < lists_.size(); ++l)
+    if (last_list[l]) last_lists_.push_back(int(l));
+  for (std::size_t i = 0; i < p.primitives.size(); ++i)
+    if (lays_some_last_[i]) thresholds_.push_back(p.primitives[i].cost_per_mm3);
+  std::sort(thresholds_.begin(), thresholds_.end());
+  thresholds_.erase(std::unique(thresholds_.begin(), thresholds_.end()), thresholds_.end());
   // The lists, tools and setups as bit masks over the primitives.
   const std::size_t prim_words = (p.primitives.size() + 63) / 64;
   auto mask = [&](auto member) {
@@ -257,17 +263,14 @@ LowerBound::AtomShares LowerBound::atom_part(const AtomSet& state, const Rates& 
 // waste an overfilling head lays with the design, laid and cut away), or, for each such
 // atom, the least rate at or above the threshold instead of the atom part's rate. Per
 // threshold (each rate of the adders that may lay design last, but the cheapest): the
-// cheaper side effect, and per last-adder list what its atoms cost beyond its rate.
+// cheaper side effect; what the atoms of each last-adder list cost beyond its rate is
+// filled in by relay_extras, when it can count.
 std::vector<LowerBound::Relay> LowerBound::relays(const Rates& r, const std::vector<double>& side) const {
-  std::vector<double> thresholds;
-  for (std::size_t i = 0; i < p_.primitives.size(); ++i)
-    if (r.allowed[i] && lays_some_last_[i]) thresholds.push_back(p_.primitives[i].cost_per_mm3);
-  std::sort(thresholds.begin(), thresholds.end());
-  thresholds.erase(std::unique(thresholds.begin(), thresholds.end()), thresholds.end());
   std::vector<Relay> out;
-  for (std::size_t k = 1; k < thresholds.size(); ++k) {
-    const double threshold = thresholds[k];
+  for (std::size_t k = 1; k < thresholds_.size(); ++k) {
+    const double threshold = thresholds_[k];
     Relay relay;
+    relay.threshold = threshold;
     relay.cheap_side = kInfinity;
     for (std::size_t i = 0; i < p_.primitives.size(); ++i) {
       const PrimitiveSpec& prim = p_.primitives[i];
@@ -275,21 +278,24 @@ std::vector<LowerBound::Relay> LowerBound::relays(const Rates& r, const std::vec
       // One that falls short may lay less than its side effects: nothing is sure.
       relay.cheap_side = std::min(relay.cheap_side, prim.falls_short.words().empty() ? side[i] : 0.0);
     }
-    if (relay.cheap_side <= 0) continue;
-    relay.extra.assign(lists_.size(), 0);
-    for (std::size_t l = 0; l < lists_.size(); ++l) {
-      if (!last_list_[l] || r.rate[l] >= threshold) continue;
-      double at_threshold = kInfinity;  // lists are cheapest first
-      for (int i : lists_[l])
-        if (r.allowed[std::size_t(i)] && p_.primitives[std::size_t(i)].cost_per_mm3 >= threshold) {
-          at_threshold = p_.primitives[std::size_t(i)].cost_per_mm3;
-          break;
-        }
-      relay.extra[l] = at_threshold - r.rate[l];
-    }
-    out.push_back(std::move(relay));
+    // Nothing allowed under it: every rate is at or above it, nothing to add.
+    if (relay.cheap_side > 0 && relay.cheap_side < kInfinity) out.push_back(std::move(relay));
   }
   return out;
+}
+
+void LowerBound::relay_extras(const Rates& r, Relay& relay) const {
+  relay.extra.assign(lists_.size(), 0);
+  for (const int l : last_lists_) {
+    if (r.rate[std::size_t(l)] >= relay.threshold) continue;
+    double at_threshold = kInfinity;  // lists are cheapest first
+    for (int i : lists_[std::size_t(l)])
+      if (r.allowed[std::size_t(i)] && p_.primitives[std::size_t(i)].cost_per_mm3 >= relay.threshold) {
+        at_threshold = p_.primitives[std::size_t(i)].cost_per_mm3;
+        break;
+      }
+    relay.extra[std::size_t(l)] = at_threshold - r.rate[std::size_t(l)];
+  }
 }
 
 // A completion removes every must-out atom present, and a removal that cuts design present
@@ -305,34 +311,20 @@ std::vector<LowerBound::Relay> LowerBound::relays(const Rates& r, const std::vec
 // `relaid` adds, per threshold, what laying last the design r* cuts and the design missing
 // costs beyond those rates (relays): the least over the removals of that threshold. It
 // bounds everything but the atom part's deposits and the fixed costs, side effects
-// included, so it stands beside the sum of the other shares, not in it.
+// included, so it stands beside the sum of the other shares, not in it; it is worked out
+// only where it may be the larger (it exceeds `plain` by at most a cheap side effect).
 LowerBound::DesignCut LowerBound::removals_with_design_cut(const AtomSet& state, const Rates& r,
-                                                           const std::vector<double>& side,
-                                                           double cheapest_removals) const {
+                                                           const SideShares& side, const AtomShares& atoms) const {
   const auto& s = state.words();
-  const std::vector<Relay> relay = relays(r, side);
-  const std::size_t kinds = relay.size();
   // Each allowed removal's design share in this state: a must-in atom present is cut by
   // exactly the removals of its remover list, so its price is summed per list once.
-  std::vector<double> per_list(lists_.size(), 0), missing_extra(kinds, 0);
-  std::vector<std::vector<double>> extra_per_list(kinds, std::vector<double>(kinds ? lists_.size() : 0, 0));
-  for (std::size_t w = 0; w < s.size(); ++w) {
+  std::vector<double> per_list(lists_.size(), 0);
+  for (std::size_t w = 0; w < s.size(); ++w)
     for (std::uint64_t b = s[w] & must_in_[w]; b; b &= b - 1) {
       const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
       per_list[std::size_t(remover_list_[a])] += r.last_deposit(a) * p_.atoms[a].volume;
-      for (std::size_t k = 0; k < kinds; ++k)
-        if (const double e = relay[k].extra[std::size_t(last_adder_list_[a])]; e > 0)
-          extra_per_list[k][std::size_t(remover_list_[a])] += e * p_.atoms[a].volume;
     }
-    for (std::uint64_t b = must_in_[w] & ~s[w]; b; b &= b - 1) {
-      const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
-      for (std::size_t k = 0; k < kinds; ++k)
-        if (const double e = relay[k].extra[std::size_t(last_adder_list_[a])]; e > 0) missing_extra[k] += e * p_.atoms[a].volume;
-    }
-  }
   const std::vector<double> cut_share = per_primitive(per_list);
-  std::vector<std::vector<double>> cut_extra;
-  for (const auto& e : extra_per_list) cut_extra.push_back(per_primitive(e));
   struct Cut {
     double share;
     int removal;
@@ -346,39 +338,23 @@ LowerBound::DesignCut LowerBound::removals_with_design_cut(const AtomSet& state,
       const auto& pa = prim.atoms.words();
       const auto& short_of = prim.falls_short.words();
       cut.share = 0;
-      for (auto& e : cut_extra) e[i] = 0;
       for (std::size_t w = 0; w < s.size(); ++w) {
         const std::uint64_t cutting = pa[w] & s[w] & must_in_[w] & ~(w < short_of.size() ? short_of[w] : 0);
         for (std::uint64_t b = cutting; b; b &= b - 1) {
           const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
           cut.share += r.last_deposit(a) * p_.atoms[a].volume;
-          for (std::size_t k = 0; k < kinds; ++k)
-            cut_extra[k][i] += relay[k].extra[std::size_t(last_adder_list_[a])] * p_.atoms[a].volume;
         }
       }
     }
     cuts.push_back(cut);
   }
   std::sort(cuts.begin(), cuts.end(), [](const Cut& x, const Cut& y) { return x.share < y.share; });
-  // What missing design costs beyond the atom part with no design laid again (threshold 0).
-  double missing_relaid = 0;
-  for (std::size_t n = 0; n < kinds; ++n) missing_relaid = std::max(missing_relaid, std::min(relay[n].cheap_side, missing_extra[n]));
-  // No removal cuts design: each must-out atom at its cheapest removal (the atom part's).
-  if (cuts.empty() || cuts.back().share == 0) return {cheapest_removals, cheapest_removals + missing_relaid};
   // Thresholds: 0 and each distinct share; per removal the first threshold admitting it.
-  // At 0 nothing need be laid again: no removal may be used at all.
   std::vector<double> threshold{0.0};
-  std::vector<std::vector<double>> least_extra(kinds, std::vector<double>{0.0});
   std::vector<int> rank(p_.primitives.size(), -1);
   for (const Cut& cut : cuts) {
-    if (cut.share > threshold.back()) {
-      threshold.push_back(cut.share);
-      for (auto& l : least_extra) l.push_back(kInfinity);
-    }
+    if (cut.share > threshold.back()) threshold.push_back(cut.share);
     rank[std::size_t(cut.removal)] = int(threshold.size()) - 1;
-    if (threshold.size() > 1)
-      for (std::size_t k = 0; k < kinds; ++k)
-        least_extra[k].back() = std::min(least_extra[k].back(), cut_extra[k][std::size_t(cut.removal)]);
   }
   const std::size_t k = threshold.size();
   // The must-out volume present per remover list: atoms of one list price alike.
@@ -407,16 +383,69 @@ LowerBound::DesignCut LowerBound::removals_with_design_cut(const AtomSet& state,
     if (lowest == int(k)) return {kInfinity, kInfinity};  // no removal left for these atoms
     priced_from = std::max(priced_from, std::size_t(lowest));  // below it they cannot go
   }
-  DesignCut best{kInfinity, kInfinity};
+  std::vector<double> base(k, kInfinity);  // threshold plus the must-out atoms' removals
+  DesignCut best{kInfinity, 0};
   double total = 0;
   for (std::size_t j = 0; j < k; ++j) {
     total += step[j];
     if (j < priced_from) continue;
-    best.plain = std::min(best.plain, threshold[j] + total);
+    base[j] = threshold[j] + total;
+    best.plain = std::min(best.plain, base[j]);
+  }
+
+  std::vector<Relay> relay = relays(r, side.of);
+  double most = 0;  // what the relay share adds at the most
+  for (const Relay& one : relay) most = std::max(most, one.cheap_side);
+  const double others = side.deposits + std::max(atoms.removals + side.removals, best.plain);
+  if (relay.empty() || best.plain + most <= others) return best;
+  for (Relay& one : relay) relay_extras(r, one);
+  const std::size_t kinds = relay.size();
+  // Per relay: the missing design's extra, and each removal's (the design it cuts).
+  std::vector<double> missing_extra(kinds, 0);
+  std::vector<std::vector<double>> extra_per_list(kinds, std::vector<double>(lists_.size(), 0));
+  for (std::size_t w = 0; w < s.size(); ++w) {
+    for (std::uint64_t b = s[w] & must_in_[w]; b; b &= b - 1) {
+      const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
+      for (std::size_t n = 0; n < kinds; ++n)
+        if (const double e = relay[n].extra[std::size_t(last_adder_list_[a])]; e > 0)
+          extra_per_list[n][std::size_t(remover_list_[a])] += e * p_.atoms[a].volume;
+    }
+    for (std::uint64_t b = must_in_[w] & ~s[w]; b; b &= b - 1) {
+      const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
+      for (std::size_t n = 0; n < kinds; ++n)
+        if (const double e = relay[n].extra[std::size_t(last_adder_list_[a])]; e > 0) missing_extra[n] += e * p_.atoms[a].volume;
+    }
+  }
+  std::vector<std::vector<double>> cut_extra;
+  for (const auto& e : extra_per_list) cut_extra.push_back(per_primitive(e));
+  for (const Cut& cut : cuts) {
+    const PrimitiveSpec& prim = p_.primitives[std::size_t(cut.removal)];
+    if (prim.falls_short.words().empty()) continue;
+    const auto& pa = prim.atoms.words();
+    const auto& short_of = prim.falls_short.words();
+    for (auto& e : cut_extra) e[std::size_t(cut.removal)] = 0;
+    for (std::size_t w = 0; w < s.size(); ++w)
+      for (std::uint64_t b = pa[w] & s[w] & must_in_[w] & ~(w < short_of.size() ? short_of[w] : 0); b; b &= b - 1) {
+        const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
+        for (std::size_t n = 0; n < kinds; ++n)
+          cut_extra[n][std::size_t(cut.removal)] += relay[n].extra[std::size_t(last_adder_list_[a])] * p_.atoms[a].volume;
+      }
+  }
+  // Per threshold the least extra of its removals; at 0 nothing need be laid again (no
+  // removal may be used at all).
+  std::vector<std::vector<double>> least_extra(kinds, std::vector<double>(k, kInfinity));
+  for (auto& l : least_extra) l[0] = 0;
+  for (const Cut& cut : cuts) {
+    const std::size_t j = std::size_t(rank[std::size_t(cut.removal)]);
+    if (j == 0) continue;
+    for (std::size_t n = 0; n < kinds; ++n) least_extra[n][j] = std::min(least_extra[n][j], cut_extra[n][std::size_t(cut.removal)]);
+  }
+  best.relaid = kInfinity;
+  for (std::size_t j = priced_from; j < k; ++j) {
     double relaid = 0;
     for (std::size_t n = 0; n < kinds; ++n)
       relaid = std::max(relaid, std::min(relay[n].cheap_side, missing_extra[n] + least_extra[n][j]));
-    best.relaid = std::min(best.relaid, threshold[j] + total + relaid);
+    best.relaid = std::min(best.relaid, base[j] + relaid);
   }
   return best;
 }
@@ -588,7 +617,7 @@ double LowerBound::operator()(const AtomSet& state, const std::vector<std::uint8
   // Removing what is present (and depositing again the design a removal cuts) is one share,
   // bounded two ways: the larger counts. The design cut with what laying design last costs
   // beyond the atom part bounds that share and the side effects together.
-  const DesignCut cut = removals_with_design_cut(state, r, side.of, atoms.removals);
+  const DesignCut cut = removals_with_design_cut(state, r, side, atoms);
   const double removals = std::max(atoms.removals + side.removals, cut.plain);
   const double rest = std::max(side.deposits + removals, cut.relaid);
   return (atoms.deposits + rest + fixed_part(state, r, last)) / p_.normaliser;

@@ -88,18 +88,20 @@ class LowerBound {
   // Per rate threshold: what laying must-in atoms last costs beyond the atom part's rate
   // (planner/search_bound.cpp: relays).
   struct Relay {
-    double cheap_side = 0;      // the least side effect of an adder under the threshold
-    std::vector<double> extra;  // per last-adder list, per mm³
+    double threshold = 0;
+    double cheap_side = 0;      // the least side effect of an allowed adder under the threshold
+    std::vector<double> extra;  // per last-adder list, per mm³ (relay_extras)
   };
   std::vector<Relay> relays(const Rates& r, const std::vector<double>& side) const;
+  void relay_extras(const Rates& r, Relay& relay) const;
   // The removals' share two ways: with the design they cut at the atom part's rates, and
-  // with what laying that design and the missing design last costs beyond them.
-  // `cheapest_removals`: the atom part's removals (each must-out atom at its cheapest).
+  // with what laying that design and the missing design last costs beyond them (0 where
+  // it cannot exceed the other shares' sum).
   struct DesignCut {
     double plain = 0, relaid = 0;
   };
-  DesignCut removals_with_design_cut(const AtomSet& state, const Rates& r, const std::vector<double>& side,
-                                     double cheapest_removals) const;
+  DesignCut removals_with_design_cut(const AtomSet& state, const Rates& r, const SideShares& side,
+                                     const AtomShares& atoms) const;
   double fixed_part(const AtomSet& state, const Rates& r, int last) const;
   void index_lists();
   void force(const AtomSet& state, const Rates& r, std::vector<bool>& tool_forced, std::vector<bool>& setup_forced) const;
@@ -116,7 +118,8 @@ class LowerBound {
   // Per atom its list of the adders that can lay it last (planner/search_bound.cpp).
   std::vector<int> last_adder_list_;
   std::vector<bool> lays_some_last_;  // per primitive: on some must-in atom's last-adder list
-  std::vector<bool> last_list_;       // per list: some must-in atom's last-adder list
+  std::vector<int> last_lists_;       // the lists that are some must-in atom's last-adder list
+  std::vector<double> thresholds_;    // the rates of the primitives that lay some design last
   std::vector<std::vector<int>> last_adders() const;
   // Per list the rate of its first (cheapest) member, and per primitive the lists it comes
   // first in: [0] with every primitive allowed, [1] with the raw stocks left out, as they
