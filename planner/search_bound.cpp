@@ -40,13 +40,15 @@ struct LowerBound::Rates {
     for (std::size_t i = 0; i < allowed.size(); ++i) stock_allowed = stock_allowed || (allowed[i] && b.p_.primitives[i].raw_stock);
     const Leaders& leaders = b.leaders_[stock_allowed ? 0 : 1];
     rate = leaders.rate;
+    // Bytes, not bits, for the lists' members looked up below: this loop is hot.
+    const std::vector<char> ok(allowed.begin(), allowed.end());
     for (std::size_t i = 0; i < allowed.size(); ++i) {
-      if (allowed[i]) continue;
+      if (ok[i]) continue;
       for (const int l : leaders.led_by[i]) {
         double& r = rate[std::size_t(l)];
         r = kInfinity;
         for (int j : b.lists_[std::size_t(l)])
-          if (allowed[std::size_t(j)]) {
+          if (ok[std::size_t(j)]) {
             r = b.p_.primitives[std::size_t(j)].cost_per_mm3;
             break;
           }
