@@ -400,8 +400,18 @@ LowerBound::DesignCut LowerBound::removals_with_design_cut(const AtomSet& state,
   for (const Relay& one : relay) most = std::max(most, one.cheap_side);
   const double others = side.deposits + std::max(atoms.removals + side.removals, best.plain);
   if (relay.empty() || best.plain + most <= others) return best;
+  best.relaid = relaid_share(state, r, relay, rank, base, priced_from);
+  return best;
+}
+
+// The relay share beside the design-cut share's thresholds (`rank` of each allowed removal,
+// -1 for the others; `base`: each threshold plus the removals it prices).
+double LowerBound::relaid_share(const AtomSet& state, const Rates& r, std::vector<Relay>& relay,
+                                const std::vector<int>& rank, const std::vector<double>& base,
+                                std::size_t priced_from) const {
+  const auto& s = state.words();
   for (Relay& one : relay) relay_extras(r, one);
-  const std::size_t kinds = relay.size();
+  const std::size_t kinds = relay.size(), k = base.size();
   // Per relay: the missing design's extra, and each removal's (the design it cuts).
   std::vector<double> missing_extra(kinds, 0);
   std::vector<std::vector<double>> extra_per_list(kinds, std::vector<double>(lists_.size(), 0));
@@ -420,34 +430,34 @@ LowerBound::DesignCut LowerBound::removals_with_design_cut(const AtomSet& state,
   }
   std::vector<std::vector<double>> cut_extra;
   for (const auto& e : extra_per_list) cut_extra.push_back(per_primitive(e));
-  for (const Cut& cut : cuts) {
-    const PrimitiveSpec& prim = p_.primitives[std::size_t(cut.removal)];
-    if (prim.falls_short.words().empty()) continue;
+  for (std::size_t i = 0; i < rank.size(); ++i) {
+    const PrimitiveSpec& prim = p_.primitives[i];
+    if (rank[i] < 0 || prim.falls_short.words().empty()) continue;
     const auto& pa = prim.atoms.words();
     const auto& short_of = prim.falls_short.words();
-    for (auto& e : cut_extra) e[std::size_t(cut.removal)] = 0;
+    for (auto& e : cut_extra) e[i] = 0;
     for (std::size_t w = 0; w < s.size(); ++w)
       for (std::uint64_t b = pa[w] & s[w] & must_in_[w] & ~(w < short_of.size() ? short_of[w] : 0); b; b &= b - 1) {
         const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
         for (std::size_t n = 0; n < kinds; ++n)
-          cut_extra[n][std::size_t(cut.removal)] += relay[n].extra[std::size_t(last_adder_list_[a])] * p_.atoms[a].volume;
+          cut_extra[n][i] += relay[n].extra[std::size_t(last_adder_list_[a])] * p_.atoms[a].volume;
       }
   }
   // Per threshold the least extra of its removals; at 0 nothing need be laid again (no
   // removal may be used at all).
   std::vector<std::vector<double>> least_extra(kinds, std::vector<double>(k, kInfinity));
   for (auto& l : least_extra) l[0] = 0;
-  for (const Cut& cut : cuts) {
-    const std::size_t j = std::size_t(rank[std::size_t(cut.removal)]);
-    if (j == 0) continue;
-    for (std::size_t n = 0; n < kinds; ++n) least_extra[n][j] = std::min(least_extra[n][j], cut_extra[n][std::size_t(cut.removal)]);
+  for (std::size_t i = 0; i < rank.size(); ++i) {
+    if (rank[i] <= 0) continue;
+    for (std::size_t n = 0; n < kinds; ++n)
+      least_extra[n][std::size_t(rank[i])] = std::min(least_extra[n][std::size_t(rank[i])], cut_extra[n][i]);
   }
-  best.relaid = kInfinity;
+  double best = kInfinity;
   for (std::size_t j = priced_from; j < k; ++j) {
     double relaid = 0;
     for (std::size_t n = 0; n < kinds; ++n)
       relaid = std::max(relaid, std::min(relay[n].cheap_side, missing_extra[n] + least_extra[n][j]));
-    best.relaid = std::min(best.relaid, base[j] + relaid);
+    best = std::min(best, base[j] + relaid);
   }
   return best;
 }

@@ -102,6 +102,8 @@ class LowerBound {
   };
   DesignCut removals_with_design_cut(const AtomSet& state, const Rates& r, const SideShares& side,
                                      const AtomShares& atoms) const;
+  double relaid_share(const AtomSet& state, const Rates& r, std::vector<Relay>& relay, const std::vector<int>& rank,
+                      const std::vector<double>& base, std::size_t priced_from) const;
   double fixed_part(const AtomSet& state, const Rates& r, int last) const;
   void index_lists();
   void force(const AtomSet& state, const Rates& r, std::vector<bool>& tool_forced, std::vector<bool>& setup_forced) const;
