@@ -27,6 +27,18 @@ std::vector<int> ids_of(const PlanningProblem& p, bool setups) {
   return out;
 }
 
+// Calls fn(a) for each must-in atom of `state` that removal `prim` surely cuts: what it
+// holds but was seen not to cut once begun (falls_short).
+template <typename F>
+void for_each_design_cut(const PrimitiveSpec& prim, const std::vector<std::uint64_t>& state,
+                         const std::vector<std::uint64_t>& must_in, F fn) {
+  const auto& pa = prim.atoms.words();
+  const auto& short_of = prim.falls_short.words();
+  for (std::size_t w = 0; w < state.size(); ++w)
+    for (std::uint64_t b = pa[w] & state[w] & must_in[w] & ~(w < short_of.size() ? short_of[w] : 0); b; b &= b - 1)
+      fn(w * 64 + std::size_t(std::countr_zero(b)));
+}
+
 }  // namespace
 
 // Which primitives may still be used, and per atom the cheapest rate at which one of them
@@ -337,16 +349,8 @@ LowerBound::DesignCut LowerBound::removals_with_design_cut(const AtomSet& state,
     if (prim.mode != Mode::Subtractive || !r.allowed[i]) continue;
     Cut cut{cut_share[i], int(i)};
     if (!prim.falls_short.words().empty()) {  // not what it was seen not to cut
-      const auto& pa = prim.atoms.words();
-      const auto& short_of = prim.falls_short.words();
       cut.share = 0;
-      for (std::size_t w = 0; w < s.size(); ++w) {
-        const std::uint64_t cutting = pa[w] & s[w] & must_in_[w] & ~(w < short_of.size() ? short_of[w] : 0);
-        for (std::uint64_t b = cutting; b; b &= b - 1) {
-          const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
-          cut.share += r.last_deposit(a) * p_.atoms[a].volume;
-        }
-      }
+      for_each_design_cut(prim, s, must_in_, [&](std::size_t a) { cut.share += r.last_deposit(a) * p_.atoms[a].volume; });
     }
     cuts.push_back(cut);
   }
@@ -433,15 +437,11 @@ double LowerBound::relaid_share(const AtomSet& state, const Rates& r, std::vecto
   for (std::size_t i = 0; i < rank.size(); ++i) {
     const PrimitiveSpec& prim = p_.primitives[i];
     if (rank[i] < 0 || prim.falls_short.words().empty()) continue;
-    const auto& pa = prim.atoms.words();
-    const auto& short_of = prim.falls_short.words();
     for (auto& e : cut_extra) e[i] = 0;
-    for (std::size_t w = 0; w < s.size(); ++w)
-      for (std::uint64_t b = pa[w] & s[w] & must_in_[w] & ~(w < short_of.size() ? short_of[w] : 0); b; b &= b - 1) {
-        const std::size_t a = w * 64 + std::size_t(std::countr_zero(b));
-        for (std::size_t n = 0; n < kinds; ++n)
-          cut_extra[n][i] += relay[n].extra[std::size_t(last_adder_list_[a])] * p_.atoms[a].volume;
-      }
+    for_each_design_cut(prim, s, must_in_, [&](std::size_t a) {
+      for (std::size_t n = 0; n < kinds; ++n)
+        cut_extra[n][i] += relay[n].extra[std::size_t(last_adder_list_[a])] * p_.atoms[a].volume;
+    });
   }
   // Per threshold the least extra of its removals; at 0 nothing need be laid again (no
   // removal may be used at all).

@@ -85,17 +85,14 @@ struct SweepJob {
   IndexBox box;
 };
 std::vector<SweepJob> sweep_jobs(std::span<const ConvexPiece> pieces, std::span<const Segment> segments,
-                                 const geometry::Lattice& lattice, const IndexBox& clip, IndexBox& all) {
+                                 const geometry::Lattice& lattice, const IndexBox& clip) {
   std::vector<SweepJob> jobs;
   jobs.reserve(pieces.size() * segments.size());
-  all = {};
   for (const Segment& s : segments)
     for (const ConvexPiece& p : pieces) {
       PieceSweep sweep(p, s, lattice);
       const IndexBox box = sweep.bounds(clip);
-      if (box.empty()) continue;
-      all = all.empty() ? box : geometry::box_union(all, box);
-      jobs.push_back({sweep, box});
+      if (!box.empty()) jobs.push_back({sweep, box});
     }
   return jobs;
 }
@@ -144,8 +141,9 @@ void for_each_swept_row(std::span<const SweepJob> jobs, const geometry::Solid* o
 // as for_each_swept_row's.
 void rasterise(RowMask& mask, std::span<const ConvexPiece> pieces, std::span<const Segment> segments,
                const geometry::Lattice& lattice, const IndexBox& clip, const geometry::Solid* only_over = nullptr) {
+  const std::vector<SweepJob> jobs = sweep_jobs(pieces, segments, lattice, clip);
   IndexBox all;
-  const std::vector<SweepJob> jobs = sweep_jobs(pieces, segments, lattice, clip, all);
+  for (const SweepJob& job : jobs) all = all.empty() ? job.box : geometry::box_union(all, job.box);
   mask.reset(all);
   for_each_swept_row(jobs, only_over, [&](int y, int z, int x0, int x1) { mask.add(y, z, x0, x1); });
 }
@@ -354,8 +352,7 @@ MoveReport MaterialSimulation::cut(const Cutter& cutter, const MaterialMove& mov
   auto remove = [&] {
     const IndexBox clip = over_material(stock_, material_box_);
     if (clip.empty()) return;
-    IndexBox all;
-    const std::vector<SweepJob> jobs = sweep_jobs(cutting, segments, lattice, clip, all);
+    const std::vector<SweepJob> jobs = sweep_jobs(cutting, segments, lattice, clip);
     const int first = stock_.first_word();
     for_each_swept_row(jobs, &stock_, [&](int y, int z, int x0, int x1) {
       std::uint64_t* s = stock_.row(y, z).data() - first;
