@@ -13,6 +13,8 @@
 #include <queue>
 #include <unordered_map>
 
+#include "common/hash.hpp"
+
 namespace hybridctl::planner::baseline {
 namespace {
 
@@ -130,13 +132,7 @@ struct Node {
   std::vector<std::uint8_t> uses;
 };
 
-struct KeyHash {
-  std::size_t operator()(const std::vector<std::uint64_t>& k) const {
-    std::uint64_t h = 0xcbf29ce484222325ull;
-    for (std::uint64_t w : k) h = (h ^ w) * 0x100000001b3ull, h ^= h >> 29;
-    return std::size_t(h);
-  }
-};
+using KeyHash = WordsHash;
 
 // Duplicate detection key: state, uses and the last primitive (fixed costs depend on it).
 std::vector<std::uint64_t> key_of(const Node& n) {

@@ -31,7 +31,7 @@ inline planner::PlanningProblem problem_of_plan_json(const std::string& path) {
   for (const auto& q : doc.at("primitives")) {
     planner::PrimitiveSpec s;
     s.name = q.at("name").get<std::string>();
-    s.mode = q.at("mode").get<std::string>() == "additive" ? planner::Mode::Additive : planner::Mode::Subtractive;
+    s.mode = q.at("mode").get<std::string>() == "additive" ? config::Mode::Additive : config::Mode::Subtractive;
     s.raw_stock = q.at("kind").get<std::string>() == "raw-stock";
     s.cost_per_mm3 = q.at("cost_per_mm3").get<double>();
     s.tool = q.at("capability").get<std::string>();

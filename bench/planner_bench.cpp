@@ -82,7 +82,7 @@ planner::PlanningProblem synthetic_problem(int n, std::uint32_t seed) {
   for (int i = 0; i < n; ++i) {
     planner::PrimitiveSpec s;
     s.name = "P" + std::to_string(i + 1);
-    s.mode = i < 2 || rng() % 2 ? planner::Mode::Additive : planner::Mode::Subtractive;
+    s.mode = i < 2 || rng() % 2 ? config::Mode::Additive : config::Mode::Subtractive;
     s.cost_per_mm3 = cost(rng);
     s.atoms = planner::AtomSet(atoms);
     for (int a = 0; a < atoms; ++a)
@@ -96,7 +96,7 @@ planner::PlanningProblem synthetic_problem(int n, std::uint32_t seed) {
   for (int k = 0; k < std::min(n, 6); ++k) {
     const auto& prim = p.primitives[std::size_t(order[std::size_t(k)])];
     for (int a = 0; a < atoms; ++a)
-      if (prim.atoms.test(a)) state.set(a, prim.mode == planner::Mode::Additive);
+      if (prim.atoms.test(a)) state.set(a, prim.mode == config::Mode::Additive);
   }
   for (int a = 0; a < atoms; ++a) {
     p.atoms[std::size_t(a)].must_in = state.test(a);

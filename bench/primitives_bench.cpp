@@ -85,7 +85,7 @@ void BM_ReferenceRemovals(benchmark::State& state) {
   // The fast path's removal regions, in machine_primitives' order, to compare against.
   std::vector<Solid> fast;
   for (auto& p : planner::machine_primitives(j.machine, j.design, j.domain))
-    if (p.mode == planner::Mode::Subtractive) fast.push_back(std::move(p.region));
+    if (p.mode == config::Mode::Subtractive) fast.push_back(std::move(p.region));
   std::size_t count = 0, mismatches = 0;
   for (auto _ : state) {
     count = mismatches = 0;

@@ -16,7 +16,7 @@
 
 #include "config/machine_loader.hpp"
 #include "geometry/mesh.hpp"
-#include "planner/plan_file.hpp"
+#include "plan/plan_file.hpp"
 #include "planner/plan_report.hpp"
 #include "report/report.hpp"
 #include "report/report_data.hpp"
@@ -31,7 +31,7 @@ double g_voxel = 0.5;
 // The plan, planned once: its directory, and the plan as `plan --report` holds it in memory.
 struct Planned {
   fs::path dir;
-  planner::PlanFile in_memory;
+  plan::PlanFile in_memory;
 };
 
 const Planned& planned() {

@@ -27,8 +27,8 @@
 #include "config/transport_uri.hpp"
 #include "geometry/mesh.hpp"
 #include "geometry/vdb_file.hpp"
-#include "planner/plan_file.hpp"
-#include "planner/deviation.hpp"
+#include "plan/plan_file.hpp"
+#include "plan/deviation.hpp"
 #include "planner/plan_report.hpp"
 #include "validation/plan_validator.hpp"
 
@@ -131,9 +131,9 @@ std::string log_tail(const fs::path& file, std::size_t lines) {
 // OUT/plan-N; prints as built against as planned and against the design, both ways, and
 // every alarm with its line. Returns true when it ran to the end with no alarm and within
 // the tolerance.
-bool dry_run_plan(const DryRunArgs& a, const planner::PlanFile& file, int rank, const fs::path& out) {
+bool dry_run_plan(const DryRunArgs& a, const plan::PlanFile& file, int rank, const fs::path& out) {
   const fs::path plan_json = file.directory / "plan.json";
-  const planner::PlanFilePlan& plan = file.plans[std::size_t(rank - 1)];
+  const plan::PlanFilePlan& plan = file.plans[std::size_t(rank - 1)];
   std::printf("plan %-6d %s  cost %.4f\n", rank, plan.expression.c_str(), plan.cost);
   fs::create_directories(out);
   // 1. A simulated controller on loopback, starting from the plan's raw stock.
@@ -178,17 +178,17 @@ bool dry_run_plan(const DryRunArgs& a, const planner::PlanFile& file, int rank, 
   }
 
   // 3. As built versus as planned and versus the design.
-  const geometry::Solid planned_shape = planner::plan_states(file, plan).back();
+  const geometry::Solid planned_shape = plan::plan_states(file, plan).back();
   const geometry::Solid built = geometry::read_vdb(as_built);
   geometry::Solid built_here(file.lattice, file.domain);
   built.for_each_voxel([&](geometry::Index3 v) {
     if (file.domain.contains(v)) built_here.set(v);
   });
   const geometry::Solid extra = subtract(built_here, planned_shape), missing = subtract(planned_shape, built_here);
-  const planner::Deviation d = planner::measure_deviation(built_here, file.design, file.domain, file.tolerance);
+  const plan::Deviation d = plan::measure_deviation(built_here, file.design, file.domain, file.tolerance);
   std::printf("as built    %.1f mm³ (planned %.1f mm³): %.1f mm³ beyond the plan, %.1f mm³ of it missing\n",
               built_here.volume(), planned_shape.volume(), extra.volume(), missing.volume());
-  std::printf("vs design   %s\n", planner::deviation_text(d, file.tolerance).c_str());
+  std::printf("vs design   %s\n", plan::deviation_text(d, file.tolerance).c_str());
   std::printf("wrote       %s: job/, as-built.vdb, sim-report.json, executed-lines.ngc\n", out.c_str());
   return d.within_tolerance && alarms.empty();
 }
@@ -216,7 +216,7 @@ int run_dry_run(const DryRunArgs& a) {
   if (!planned.verdict.manufacturable || planned.plans.empty()) return kNotManufacturable;
   const fs::path plan_dir = out / "plan";
   planner::write_plan_directory(planned, sources, plan_dir);
-  const planner::PlanFile file = planner::to_plan_file(planned, sources, plan_dir);
+  const plan::PlanFile file = planner::to_plan_file(planned, sources, plan_dir);
   const int plans = int(file.plans.size());
   if (!a.all && (a.plan < 1 || a.plan > plans))
     throw InputError("--plan " + std::to_string(a.plan) + ": expected 1.." + std::to_string(plans) + " (the plans offered)");

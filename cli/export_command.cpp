@@ -9,7 +9,7 @@
 #include "cli/export_run.hpp"
 #include "cli/progress.hpp"
 #include "common/error.hpp"
-#include "planner/plan_machine.hpp"
+#include "plan/plan_machine.hpp"
 #include "gcode/check.hpp"
 #include "gcode/files.hpp"
 #include "toolpaths/plan_export.hpp"
@@ -21,18 +21,18 @@ namespace hybridctl::cli {
 namespace fs = std::filesystem;
 
 int export_plan_programs(const ExportRequest& request) {
-  return export_plan_programs(planner::read_plan_file(request.plan), request);
+  return export_plan_programs(plan::read_plan_file(request.plan), request);
 }
 
-int export_plan_programs(const planner::PlanFile& file, const ExportRequest& request) {
-  const planner::PlanMachine chosen = planner::plan_machine(file, {request.machine, request.machine_override});
+int export_plan_programs(const plan::PlanFile& file, const ExportRequest& request) {
+  const plan::PlanMachine chosen = plan::plan_machine(file, {request.machine, request.machine_override});
   if (!chosen.note.empty()) std::fprintf(stderr, "%s\n", chosen.note.c_str());
   const config::Machine& machine = chosen.machine;
   if (file.plans.empty()) throw InputError(request.plan + ": the plan file holds no plans (the part was not manufacturable)");
   if (request.rank < 1 || request.rank > int(file.plans.size()))
     throw InputError("--plan " + std::to_string(request.rank) + ": expected 1.." + std::to_string(file.plans.size()) +
                      " (the plans in " + request.plan + ")");
-  const planner::PlanFilePlan& plan = file.plans[std::size_t(request.rank - 1)];
+  const plan::PlanFilePlan& plan = file.plans[std::size_t(request.rank - 1)];
 
   toolpaths::ExportOptions options;
   if (!request.dialect.empty()) {
@@ -78,7 +78,7 @@ int export_plan_programs(const planner::PlanFile& file, const ExportRequest& req
                 gcode::format_duration(report.time.total).c_str(), path.filename().string().c_str());
     for (const std::string& w : a.program.path.warnings) std::printf("       warning: %s\n", w.c_str());
   }
-  const planner::Deviation& d = run.deviation;
+  const plan::Deviation& d = run.deviation;
   std::printf("executed    from the raw stock: %zu lines; as built %.1f mm³ over, %.1f mm³ under the design, worst "
               "%.2f mm (tolerance %.2f mm, %s)\n",
               run.program.lines.size(), d.over_volume, d.under_volume, d.worst_distance, file.tolerance,

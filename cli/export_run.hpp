@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "planner/plan_file.hpp"
+#include "plan/plan_file.hpp"
 
 namespace hybridctl::cli {
 
@@ -18,6 +18,6 @@ struct ExportRequest {
 
 int export_plan_programs(const ExportRequest& request);
 // The same for a plan already in memory (request.plan names it in messages).
-int export_plan_programs(const planner::PlanFile& file, const ExportRequest& request);
+int export_plan_programs(const plan::PlanFile& file, const ExportRequest& request);
 
 }  // namespace hybridctl::cli

@@ -47,7 +47,7 @@ planner::PrimitiveFile parse_primitive_argument(const std::string& arg) {
   if (mode != "am" && mode != "sm") {
     throw InputError("--primitive " + arg + ": expected FILE:am or FILE:sm (additive or subtractive)");
   }
-  return {arg.substr(0, colon), mode == "am" ? planner::Mode::Additive : planner::Mode::Subtractive, 1.0};
+  return {arg.substr(0, colon), mode == "am" ? config::Mode::Additive : config::Mode::Subtractive, 1.0};
 }
 
 int run_plan(const PlanArgs& args) {
@@ -103,8 +103,8 @@ int run_plan(const PlanArgs& args) {
   const bool exports = !args.export_dir.empty() && result.verdict.manufacturable && !result.plans.empty();
   // The plan in memory is the plan on disk (PlanInMemory tests): report and export need not
   // read its solids back.
-  const planner::PlanFile in_memory =
-      args.report || exports ? planner::to_plan_file(result, sources, plan_dir) : planner::PlanFile{};
+  const plan::PlanFile in_memory =
+      args.report || exports ? planner::to_plan_file(result, sources, plan_dir) : plan::PlanFile{};
   if (args.report) {  // also, and most of all, for a part that is not manufacturable
     report::ReportRequest request;
     request.plan = plan_dir;

@@ -163,7 +163,7 @@ void print_report(const drivers::JobResult& job) {
 // A plan's program as export writes it: each action planned against the material the
 // ones before it leave, executed on the simulated machine from the raw stock first; a plan
 // that does not make the part is refused (exit 4) before anything is streamed.
-gcode::PostedProgram proven_plan_program(const planner::PlanFile& file, const planner::PlanFilePlan& plan,
+gcode::PostedProgram proven_plan_program(const plan::PlanFile& file, const plan::PlanFilePlan& plan,
                                          const config::Machine& machine, const gcode::PostOptions& post) {
   validation::ExecutionOptions options;
   options.export_options.post = post;

@@ -13,6 +13,8 @@
 #include <string_view>
 #include <vector>
 
+#include "config/primitive_kind.hpp"
+
 namespace hybridctl::config {
 
 /// A closed interval [min, max]; the loader guarantees min < max.
@@ -51,14 +53,7 @@ struct Envelope {
   }
 };
 
-/// The kinds of primitive the planner may derive from a head or a tool
-/// (ARCHITECTURE.md, "The planning core").
-enum class PrimitiveKind {
-  UAm,     ///< "u-am": maximal depositable region inside the design
-  OAm,     ///< "o-am": conservative overfill
-  SmMax,   ///< "sm-max": maximal removable region that never cuts the design
-  SmCons,  ///< "sm-cons": conservative over-cut
-};
+
 
 /// What a head builds without support (docs/support.md): the layer rule's cone and how far
 /// a bead may span air between two supports. The one definition of the rule the planner's
@@ -386,16 +381,6 @@ struct Machine {
   }
 };
 
-// Names as written in the machine file.
-constexpr std::string_view to_string(PrimitiveKind k) {
-  switch (k) {
-    case PrimitiveKind::UAm: return "u-am";
-    case PrimitiveKind::OAm: return "o-am";
-    case PrimitiveKind::SmMax: return "sm-max";
-    case PrimitiveKind::SmCons: return "sm-cons";
-  }
-  return "?";
-}
 constexpr std::string_view to_string(DepositionProcess p) {
   switch (p) {
     case DepositionProcess::DedPowder: return "ded-powder";

@@ -14,7 +14,7 @@
 #include "gcode/post.hpp"
 #include "gcode/program.hpp"
 #include "protocol/chunk.hpp"
-#include "planner/plan_machine.hpp"
+#include "plan/plan_machine.hpp"
 #include "toolpaths/plan_export.hpp"
 
 namespace hybridctl::drivers {
@@ -69,8 +69,8 @@ void assemble_new_job(const JobRequest& request, Job& job, JobOperator& op) {
   const bool is_plan = fs::is_directory(in) || in.extension() == ".json";
   if (!is_plan && request.machine.empty()) throw InputError("--machine: expected the machine file");
   if (is_plan) {
-    const planner::PlanFile file = planner::read_plan_file(in);
-    planner::PlanMachine chosen = planner::plan_machine(file, {request.machine, request.machine_override});
+    const plan::PlanFile file = plan::read_plan_file(in);
+    plan::PlanMachine chosen = plan::plan_machine(file, {request.machine, request.machine_override});
     if (!chosen.note.empty()) op.note(chosen.note);
     job.machine = std::move(chosen.machine);
     if (chosen.file.empty()) job.embedded_machine = std::move(chosen.text);

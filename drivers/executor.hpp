@@ -22,7 +22,7 @@
 
 #include "drivers/streamer.hpp"
 #include "gcode/post.hpp"
-#include "planner/plan_file.hpp"
+#include "plan/plan_file.hpp"
 #include "drivers/transport.hpp"
 
 namespace hybridctl::gcode {
@@ -43,7 +43,7 @@ struct JobRequest {
   /// With a plan: how its program is made. Unset: toolpaths::export_plan on the plan's
   /// planned states, then gcode::post_program. The CLI gives validation's, which plans each
   /// action against the material present and refuses a plan that does not make the part.
-  std::function<gcode::PostedProgram(const planner::PlanFile&, const planner::PlanFilePlan&, const config::Machine&,
+  std::function<gcode::PostedProgram(const plan::PlanFile&, const plan::PlanFilePlan&, const config::Machine&,
                                      const gcode::PostOptions&)>
       plan_program;
   double wait_for_controller_s = 120;  ///< a controller silent mid-stream is waited for this long (StreamOptions)

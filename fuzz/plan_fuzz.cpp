@@ -20,7 +20,7 @@
 #include "common/error.hpp"
 #include "fuzz/fuzz_check.hpp"
 #include "geometry/vdb_file.hpp"
-#include "planner/plan_file.hpp"
+#include "plan/plan_file.hpp"
 
 namespace fs = std::filesystem;
 namespace geometry = hybridctl::geometry;
@@ -63,18 +63,18 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
   const fs::path json_path = *plan_dir / "plan.json";
-  planner::PlanFile file;
+  plan::PlanFile file;
   try {
-    file = planner::parse_plan_file(text, json_path);
+    file = plan::parse_plan_file(text, json_path);
   } catch (const hybridctl::InputError& e) {
     FUZZ_CHECK(std::string_view(e.what()).starts_with(plan_dir->string()), "a plan.json error names the file");
     return 0;
   }
-  for (const planner::PlanFilePlan& plan : file.plans) {
-    for (const planner::PlanFileAction& a : plan.actions)
+  for (const plan::PlanFilePlan& plan : file.plans) {
+    for (const plan::PlanFileAction& a : plan.actions)
       FUZZ_CHECK(a.primitive >= 0 && std::size_t(a.primitive) < file.primitives.size(),
                  "every action names one of the plan's primitives");
-    const auto states = planner::plan_states(file, plan);
+    const auto states = plan::plan_states(file, plan);
     FUZZ_CHECK(states.size() == plan.actions.size() + 1, "one state before the plan and one after each action");
   }
   return 0;

@@ -23,17 +23,6 @@ std::string setup_words(const config::Setup& s) {
 
 }  // namespace
 
-const char* to_string(PrimitiveKind k) {
-  switch (k) {
-    case PrimitiveKind::RawStock: return "raw-stock";
-    case PrimitiveKind::UAm: return "u-am";
-    case PrimitiveKind::OAm: return "o-am";
-    case PrimitiveKind::SmMax: return "sm-max";
-    case PrimitiveKind::SmCons: return "sm-cons";
-    case PrimitiveKind::File: return "file";
-  }
-  return "?";
-}
 
 // Deposition builds layer on layer from below the nozzle: the nozzle body constrains
 // the toolpath's clearance moves, not the depositable shape (ARCHITECTURE.md).

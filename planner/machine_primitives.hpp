@@ -15,8 +15,7 @@
 
 namespace hybridctl::planner {
 
-enum class PrimitiveKind { RawStock, UAm, OAm, SmMax, SmCons, File };
-const char* to_string(PrimitiveKind k);
+using config::PrimitiveKind;
 
 struct Primitive {
   std::string name;          // P1, P2, ... in order

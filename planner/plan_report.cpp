@@ -13,9 +13,14 @@
 #include "common/number_text.hpp"
 #include "common/error.hpp"
 #include "geometry/vdb_file.hpp"
-#include "planner/plan_machine.hpp"
+#include "plan/plan_machine.hpp"
 
 namespace hybridctl::planner {
+
+using plan::kPlanFormatVersion;
+using plan::machine_text_hash;
+using plan::path_from_plan_directory;
+
 namespace {
 
 using nlohmann::json;
@@ -24,7 +29,7 @@ json vec(const geometry::Vec3& v) { return json::array({v.x, v.y, v.z}); }
 json ivec(const geometry::Index3& v) { return json::array({v.x, v.y, v.z}); }
 json box_json(const geometry::Box3& b) { return {{"min", vec(b.min)}, {"max", vec(b.max)}}; }
 
-const char* mode_name(Mode m) { return m == Mode::Additive ? "additive" : "subtractive"; }
+std::string mode_name(Mode m) { return std::string(config::to_string(m)); }
 
 const char* modality_name(Modality m) {
   switch (m) {
@@ -58,7 +63,7 @@ json class_reasons(bool core, bool thin_feature, bool beyond_hull, bool thin_gap
   return r;
 }
 
-json deviation_json(const Deviation& d) {
+json deviation_json(const plan::Deviation& d) {
   return {{"over_volume", d.over_volume},
           {"under_volume", d.under_volume},
           {"worst_over", d.worst_over},
@@ -120,7 +125,7 @@ std::string optimality_text(const Plan& plan, std::size_t k) {
   return "within " + percent + " of optimal (proven)";
 }
 
-json reason_json(const RejectionReason& reason) {
+json reason_json(const plan::RejectionReason& reason) {
   json j = {{"kind", reason.kind}};
   if (reason.action > 0) j["action"] = reason.action;
   if (reason.line > 0) j["line"] = reason.line;
@@ -144,7 +149,7 @@ json rejected_json(const PlanningResult& r) {
                        {"cost", step.cost}});
     }
     json reasons = json::array();
-    for (const RejectionReason& reason : candidate.reasons) reasons.push_back(reason_json(reason));
+    for (const plan::RejectionReason& reason : candidate.reasons) reasons.push_back(reason_json(reason));
     rejected.push_back({{"expression", expression(r.problem, candidate.plan)},
                         {"cost", candidate.plan.cost},
                         {"steps", steps},
@@ -220,7 +225,7 @@ std::string rejected_summary(const PlanningResult& r) {
       os << "\n";
       continue;
     }
-    const RejectionReason& first = candidate.reasons.front();
+    const plan::RejectionReason& first = candidate.reasons.front();
     const std::string text = describe(first);
     const bool again = std::find(told.begin(), told.end(), text) != told.end();
     os << ": " << first.kind;
@@ -236,14 +241,6 @@ std::string rejected_summary(const PlanningResult& r) {
 }
 
 }  // namespace
-
-std::string path_from_plan_directory(const std::string& path, const std::filesystem::path& directory) {
-  namespace fs = std::filesystem;
-  if (path.empty()) return path;
-  const fs::path absolute = fs::absolute(path).lexically_normal();
-  const fs::path relative = absolute.lexically_relative(fs::absolute(directory).lexically_normal());
-  return relative.empty() ? absolute.generic_string() : relative.generic_string();
-}
 
 std::string primitive_capability(const Primitive& p, const std::filesystem::path& directory) {
   return p.kind == PrimitiveKind::File || p.from_file ? path_from_plan_directory(p.capability, directory) : p.capability;
@@ -273,7 +270,7 @@ json plans_json(const PlanningResult& r) {
                                                   : json(nullptr)},
                          {"region_atoms", atom_ids(step_region(r, plan, s), r.atoms.atom_count())}});
     }
-    const Deviation& d = r.deviations[k];
+    const plan::Deviation& d = r.deviations[k];
     plans.push_back({{"rank", k + 1},
                      {"expression", expression(r.problem, plan)},
                      {"cost", plan.cost},
@@ -325,7 +322,7 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
 
   json prims = json::array();
   for (const Primitive& p : r.primitives) {
-    json j = {{"name", p.name},       {"label", p.label},       {"kind", to_string(p.kind)},
+    json j = {{"name", p.name},       {"label", p.label},       {"kind", std::string(config::to_string(p.kind))},
               {"mode", mode_name(p.mode)}, {"capability", primitive_capability(p, directory)}, {"setup", p.setup},
               {"cost_per_mm3", p.cost_per_mm3}, {"volume", p.region.volume()},
               {"file", "primitives/" + p.name + ".vdb"}};
@@ -545,7 +542,7 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
             "factors are not times (--objective time or money ranks by the toolpaths, docs/costs.md)\n";
     for (std::size_t k = 0; k < r.plans.size(); ++k) {
       const Plan& plan = r.plans[k];
-      const Deviation& d = r.deviations[k];
+      const plan::Deviation& d = r.deviations[k];
       const PlanEstimate estimate = k < r.estimates.size() ? r.estimates[k] : PlanEstimate{};
       os << "  " << (k + 1) << ". " << expression(r.problem, plan) << "  cost " << cost_text(r, plan.cost) << ", "
          << optimality_text(plan, search_rank(r, k));
@@ -557,7 +554,7 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
       const json toolpaths = toolpath_total(r, k);
       if (!toolpaths.is_null()) os << "; toolpaths " << duration_text(toolpaths.get<double>());
       os << "\n";
-      os << "     deviation: " << deviation_text(d, r.tolerance) << "\n";
+      os << "     deviation: " << plan::deviation_text(d, r.tolerance) << "\n";
       for (std::size_t s = 0; s < plan.steps.size(); ++s) {
         const PlanStep& st = plan.steps[s];
         const Primitive& p = r.primitives[std::size_t(st.primitive)];
@@ -576,6 +573,40 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
     }
   }
   return os.str();
+}
+
+}  // namespace hybridctl::planner
+
+namespace hybridctl::planner {
+
+plan::PlanFile to_plan_file(const PlanningResult& r, const ReportSources& sources, const std::filesystem::path& directory) {
+  plan::PlanFile f;
+  f.directory = directory;
+  f.part = plan::path_from_plan_directory(sources.part_path, directory);
+  f.machine_name = sources.machine_name;
+  f.machine_file = plan::path_from_plan_directory(sources.machine_path, directory);
+  f.machine_yaml = sources.machine_text;
+  f.machine_hash = plan::machine_text_hash(sources.machine_text);
+  f.lattice = r.lattice;
+  f.domain = r.domain;
+  f.tolerance = r.tolerance;
+  f.design = plan::as_read_back(r.design, f.lattice, f.domain);
+  for (const Primitive& p : r.primitives) {
+    f.primitives.push_back({p.name, p.label, p.kind, p.mode, primitive_capability(p, directory), p.setup, p.tool_number,
+                            plan::as_read_back(p.region, f.lattice, f.domain)});
+  }
+  for (std::size_t k = 0; k < r.plans.size(); ++k) {
+    const Plan& plan = r.plans[k];
+    plan::PlanFilePlan out{int(k + 1), expression(r.problem, plan), plan.cost, {}};
+    for (const PlanStep& step : plan.steps) out.actions.push_back({step.primitive, step.volume, step.cost});
+    f.plans.push_back(std::move(out));
+  }
+  for (const RejectedPlan& rejected : r.rejected) {
+    plan::PlanFileRejected out{expression(r.problem, rejected.plan), rejected.plan.cost, {}, rejected.reasons};
+    for (const PlanStep& step : rejected.plan.steps) out.actions.push_back({step.primitive, step.volume, step.cost});
+    f.rejected.push_back(std::move(out));
+  }
+  return f;
 }
 
 }  // namespace hybridctl::planner

@@ -6,11 +6,10 @@
 #include <filesystem>
 #include <string>
 
+#include "plan/plan_file.hpp"
 #include "planner/planning.hpp"
 
 namespace hybridctl::planner {
-
-inline constexpr int kPlanFormatVersion = 1;
 
 struct ReportSources {
   std::string part_path;     // as given (the summary prints it so)
@@ -23,12 +22,15 @@ struct ReportSources {
 // relative to that directory.
 std::string plan_json(const PlanningResult& result, const ReportSources& sources, const std::filesystem::path& directory);
 
-// `path` (absolute, or relative to the working directory) as plan.json in `directory`
-// records it: relative to that directory, or absolute when no relative path leads there.
-std::string path_from_plan_directory(const std::string& path, const std::filesystem::path& directory);
 // A primitive's `capability` as plan.json records it: a file primitive's path relative to
 // the plan's directory, any other as it is.
 std::string primitive_capability(const Primitive& primitive, const std::filesystem::path& directory);
+
+// The planning result as write_plan_directory(result, sources, directory) writes it and
+// plan::read_plan_file(directory) reads it back, without the files: equal to what is read
+// back, down to where each solid stores its voxels.
+plan::PlanFile to_plan_file(const PlanningResult& result, const ReportSources& sources,
+                            const std::filesystem::path& directory);
 
 // Writes DIR/plan.json, DIR/design.vdb, DIR/primitives/Pn.vdb, DIR/plans/plan-k.vdb.
 // DIR must not exist, be empty, or hold an earlier plan (it is replaced); anything else

@@ -317,7 +317,7 @@ std::function<bool(const Plan&)> known_failure_hook(const PlanningOptions& optio
       });
     };
     for (const RejectedPlan& known : r.rejected)
-      for (const RejectionReason& reason : known.reasons) {
+      for (const plan::RejectionReason& reason : known.reasons) {
         const std::size_t k = std::size_t(reason.action);
         if (k == 0 || k > plan.steps.size() || k > known.plan.steps.size()) continue;
         if (reason.kind == "missing_material" && !only_removes_after(k)) continue;
@@ -659,7 +659,7 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
     r.timings.emplace_back("validate", validation_seconds);
   }
   for (const Plan& plan : r.plans) {
-    r.deviations.push_back(measure_deviation(plan_outcome(r, plan), r.design, r.domain, r.tolerance));
+    r.deviations.push_back(plan::measure_deviation(plan_outcome(r, plan), r.design, r.domain, r.tolerance));
     r.estimates.push_back(estimate_plan(machine, r.primitives, plan));
     if (options.toolpath_minutes) r.toolpath_minutes.push_back(options.toolpath_minutes(plan));
   }

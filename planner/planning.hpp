@@ -15,9 +15,9 @@
 #include "planner/fine_graining.hpp"
 #include "planner/check.hpp"
 #include "planner/costing.hpp"
-#include "planner/deviation.hpp"
+#include "plan/deviation.hpp"
 #include "planner/machine_primitives.hpp"
-#include "planner/rejection.hpp"
+#include "plan/rejection.hpp"
 #include "planner/search.hpp"
 #include "planner/shortfall.hpp"
 
@@ -89,7 +89,7 @@ struct PlanningOptions {
 // A candidate plan that validation turned down, with its reasons.
 struct RejectedPlan {
   Plan plan;
-  std::vector<RejectionReason> reasons;
+  std::vector<plan::RejectionReason> reasons;
 };
 
 struct PlanningResult {
@@ -106,7 +106,7 @@ struct PlanningResult {
   PlanningProblem problem;
   Verdict verdict;
   std::vector<Plan> plans;
-  std::vector<Deviation> deviations;  // one per plan: its outcome against the design
+  std::vector<plan::Deviation> deviations;  // one per plan: its outcome against the design
   std::vector<RejectedPlan> rejected;  // candidates validation turned down, in the order found
   // What execution showed the primitives do not do (taken out of `problem`'s primitives),
   // in the order learned, how many searches ran (1 + the restarts they caused), and how

@@ -11,11 +11,12 @@
 #include <string>
 #include <vector>
 
+#include "config/primitive_kind.hpp"
 #include "planner/atom_set.hpp"
 
 namespace hybridctl::planner {
 
-enum class Mode { Additive, Subtractive };
+using config::Mode;
 
 struct AtomSpec {
   double volume = 0;  // mm^3

@@ -7,6 +7,7 @@
 #include <set>
 #include <vector>
 
+#include "common/hash.hpp"
 #include "planner/search.hpp"
 
 namespace hybridctl::planner::detail {
@@ -42,13 +43,7 @@ bool simulate(const PlanningProblem& p, const std::vector<int>& sequence, Plan& 
 // Appends `uses` to a duplicate-detection key, eight counts a word.
 void append_uses(std::vector<std::uint64_t>& key, const std::vector<std::uint8_t>& uses);
 
-struct KeyHash {
-  std::size_t operator()(const std::vector<std::uint64_t>& k) const {
-    std::uint64_t h = 0xcbf29ce484222325ull;
-    for (std::uint64_t w : k) h = (h ^ w) * 0x100000001b3ull, h ^= h >> 29;
-    return std::size_t(h);
-  }
-};
+using KeyHash = WordsHash;
 
 // What becomes of a plan a search reaches the goal with: returned, passed over (known
 // already, doing what a returned one does, known to fail, or turned down by

@@ -116,7 +116,7 @@ std::vector<Shortfall> find_missing_core_shortfalls(const PlanningProblem& probl
 
 std::vector<Shortfall> find_skipped_layer_shortfalls(const PlanningProblem& problem, const AtomDecomposition& atoms,
                                                      const Plan& plan, std::size_t steps, const geometry::Solid& built,
-                                                     const std::vector<RejectionReason>& reasons) {
+                                                     const std::vector<plan::RejectionReason>& reasons) {
   const std::size_t executed = std::min(steps, plan.steps.size());
   if (executed < 2) return {};  // never the first action (find_shortfalls)
   const int n = atoms.atom_count();
@@ -126,7 +126,7 @@ std::vector<Shortfall> find_skipped_layer_shortfalls(const PlanningProblem& prob
   const PrimitiveSpec& prim = problem.primitives[std::size_t(primitive)];
   if (prim.mode != Mode::Additive || prim.raw_stock) return {};
   std::vector<Shortfall> out;
-  for (const RejectionReason& reason : reasons) {
+  for (const plan::RejectionReason& reason : reasons) {
     if (reason.kind != "layer_skipped" || reason.action != int(executed) || !reason.where) continue;
     for_each_voxel_near(atoms, *reason.where, [&](Index3 v) {
       if (built.contains(v)) return;
@@ -141,7 +141,7 @@ std::vector<Shortfall> find_skipped_layer_shortfalls(const PlanningProblem& prob
 
 std::vector<Shortfall> find_spills(const PlanningProblem& problem, const AtomDecomposition& atoms, const Plan& plan,
                                    std::size_t steps, const geometry::Solid& built,
-                                   const std::vector<RejectionReason>& reasons) {
+                                   const std::vector<plan::RejectionReason>& reasons) {
   const std::size_t executed = std::min(steps, plan.steps.size());
   int deposit = -1;  // the last deposit executed, raw stock aside
   for (std::size_t k = 0; k < executed; ++k) {
@@ -155,7 +155,7 @@ std::vector<Shortfall> find_spills(const PlanningProblem& problem, const AtomDec
   const int primitive = plan.steps[std::size_t(deposit)].primitive;
   // The atoms with material near the worst excess.
   std::vector<char> near_worst(std::size_t(n), 0);
-  for (const RejectionReason& reason : reasons)
+  for (const plan::RejectionReason& reason : reasons)
     if (reason.kind == "excess_material" && reason.where)
       for_each_voxel_near(atoms, *reason.where, [&](Index3 v) {
         if (built.contains(v)) near_worst[std::size_t(atoms.atom_at(v))] = 1;

@@ -16,7 +16,7 @@
 
 #include "geometry/solid.hpp"
 #include "planner/atoms.hpp"
-#include "planner/rejection.hpp"
+#include "plan/rejection.hpp"
 #include "planner/search.hpp"
 
 namespace hybridctl::planner {
@@ -34,9 +34,9 @@ struct Shortfall {
 // What validation says of one candidate: no reasons, it makes the part; else why not, and
 // the shortfalls its execution showed (possibly none).
 struct CandidateCheck {
-  CandidateCheck(std::vector<RejectionReason> reasons = {}, std::vector<Shortfall> shortfalls = {})
+  CandidateCheck(std::vector<plan::RejectionReason> reasons = {}, std::vector<Shortfall> shortfalls = {})
       : reasons(std::move(reasons)), shortfalls(std::move(shortfalls)) {}
-  std::vector<RejectionReason> reasons;
+  std::vector<plan::RejectionReason> reasons;
   std::vector<Shortfall> shortfalls;
 };
 
@@ -72,7 +72,7 @@ std::vector<Shortfall> find_missing_core_shortfalls(const PlanningProblem& probl
 // them taken out, the search stops offering the same deposit to fill the same spot.
 std::vector<Shortfall> find_skipped_layer_shortfalls(const PlanningProblem& problem, const AtomDecomposition& atoms,
                                                      const Plan& plan, std::size_t steps, const geometry::Solid& built,
-                                                     const std::vector<RejectionReason>& reasons);
+                                                     const std::vector<plan::RejectionReason>& reasons);
 
 // A deposit's beads reach past its primitive where the model does not see it (under a
 // leaning wall the bead's edge lies out beyond the tolerance where no cutter from above
@@ -83,6 +83,6 @@ std::vector<Shortfall> find_skipped_layer_shortfalls(const PlanningProblem& prob
 // deposits, the search knows the material it leaves and that nothing clears it.
 std::vector<Shortfall> find_spills(const PlanningProblem& problem, const AtomDecomposition& atoms, const Plan& plan,
                                    std::size_t steps, const geometry::Solid& built,
-                                   const std::vector<RejectionReason>& reasons);
+                                   const std::vector<plan::RejectionReason>& reasons);
 
 }  // namespace hybridctl::planner

@@ -1,4 +1,4 @@
-// CRC-32 by a 256-entry table built at compile time; FNV-1a 64 is inline in the header.
+// CRC-32 by a 256-entry table built at compile time; FNV-1a 64 is common/hash.hpp.
 
 #include "protocol/checksums.hpp"
 
@@ -39,12 +39,6 @@ std::uint32_t crc32(std::string_view text) {
   Crc32 crc;
   crc.update(text);
   return crc.value();
-}
-
-std::uint64_t fnv1a64(std::string_view text) {
-  Fnv1a64 h;
-  h.update(text);
-  return h.value();
 }
 
 }  // namespace hybridctl::protocol

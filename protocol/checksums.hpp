@@ -10,6 +10,8 @@
 #include <span>
 #include <string_view>
 
+#include "common/hash.hpp"
+
 namespace hybridctl::protocol {
 
 class Crc32 {
@@ -25,23 +27,8 @@ class Crc32 {
 std::uint32_t crc32(std::span<const std::uint8_t> bytes);
 std::uint32_t crc32(std::string_view text);
 
-class Fnv1a64 {
- public:
-  static constexpr std::uint64_t kOffsetBasis = 0xCBF29CE484222325ull;
-  static constexpr std::uint64_t kPrime = 0x100000001B3ull;
-
-  void update(std::span<const std::uint8_t> bytes) {
-    for (std::uint8_t b : bytes) state_ = (state_ ^ b) * kPrime;
-  }
-  void update(std::string_view text) {
-    for (char c : text) state_ = (state_ ^ static_cast<std::uint8_t>(c)) * kPrime;
-  }
-  std::uint64_t value() const { return state_; }
-
- private:
-  std::uint64_t state_ = kOffsetBasis;
-};
-
-std::uint64_t fnv1a64(std::string_view text);
+// The program identity's hash is the project's one (common/hash.hpp).
+using hybridctl::Fnv1a64;
+using hybridctl::fnv1a64;
 
 }  // namespace hybridctl::protocol

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-namespace hybridctl::planner {
+namespace hybridctl::plan {
 struct PlanFile;
 }
 
@@ -38,7 +38,7 @@ struct ReportRequest {
   std::filesystem::path plan;        // plan.json or its directory
   // The plan as `plan` holds it (`plan --report`), equal to what PLAN_DIR reads back as
   // (planner::to_plan_file): its solids are not read back from the .vdb files. Null: read.
-  const planner::PlanFile* in_memory = nullptr;
+  const plan::PlanFile* in_memory = nullptr;
   std::filesystem::path output;      // the page; empty: PLAN_DIR/report.html
   std::filesystem::path as_built;    // optional: `sim serve --as-built` of a run of plan 1
   std::filesystem::path run_report;  // optional: `sim serve --report` of that run

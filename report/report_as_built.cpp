@@ -6,7 +6,7 @@
 
 namespace hybridctl::report {
 
-AsBuilt as_built(const planner::PlanFile& file, const std::filesystem::path& as_built_vdb) {
+AsBuilt as_built(const plan::PlanFile& file, const std::filesystem::path& as_built_vdb) {
   const geometry::Solid read = geometry::read_vdb(as_built_vdb);
   if (!read.empty() && !(read.lattice() == file.lattice))
     throw InputError(as_built_vdb.string() + ": a grid of " + std::to_string(read.voxel_size()) +
@@ -18,7 +18,7 @@ AsBuilt as_built(const planner::PlanFile& file, const std::filesystem::path& as_
     if (file.domain.contains(v)) out.built.set(v);
   });
   const geometry::Solid over = subtract(out.built, file.design), under = subtract(file.design, out.built);
-  // Within the tolerance as planner::measure_deviation counts it: voxel centres at most the
+  // Within the tolerance as plan::measure_deviation counts it: voxel centres at most the
   // tolerance plus half a voxel apart (the distance to the surface between the voxels).
   const geometry::Ball band{file.tolerance + file.lattice.voxel_size / 2};
   out.over_beyond = subtract(over, geometry::dilate(file.design, band, file.domain));

@@ -5,7 +5,7 @@
 
 #include <filesystem>
 
-#include "planner/plan_file.hpp"
+#include "plan/plan_file.hpp"
 
 namespace hybridctl::report {
 
@@ -17,6 +17,6 @@ struct AsBuilt {
 
 // Reads `as_built_vdb` (sim serve --as-built) onto the plan's lattice. Throws
 // hybridctl::InputError naming the file when it cannot be read or is on another grid.
-AsBuilt as_built(const planner::PlanFile& file, const std::filesystem::path& as_built_vdb);
+AsBuilt as_built(const plan::PlanFile& file, const std::filesystem::path& as_built_vdb);
 
 }  // namespace hybridctl::report

@@ -24,7 +24,7 @@ std::string code_key(const std::string& code) {
 
 }  // namespace
 
-AtomSolids atom_solids(const planner::PlanFile& file, const std::vector<std::string>& codes,
+AtomSolids atom_solids(const plan::PlanFile& file, const std::vector<std::string>& codes,
                        const std::vector<std::string>& classes, const std::vector<int>& violating) {
   const std::size_t n = file.primitives.size();
   std::unordered_map<std::string, int> atom_of;

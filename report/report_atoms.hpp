@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "planner/plan_file.hpp"
+#include "plan/plan_file.hpp"
 
 namespace hybridctl::report {
 
@@ -19,7 +19,7 @@ struct AtomSolids {
 // `codes[a]` and `classes[a]` of atom a as plan.json has them; `violating` the atom ids
 // to keep one by one. Throws hybridctl::InputError when a code's length is not the number
 // of primitives.
-AtomSolids atom_solids(const planner::PlanFile& file, const std::vector<std::string>& codes,
+AtomSolids atom_solids(const plan::PlanFile& file, const std::vector<std::string>& codes,
                        const std::vector<std::string>& classes, const std::vector<int>& violating);
 
 }  // namespace hybridctl::report

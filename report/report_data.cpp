@@ -9,7 +9,8 @@
 #include <tbb/parallel_for.h>
 
 #include "common/error.hpp"
-#include "planner/plan_machine.hpp"
+#include "common/hash.hpp"
+#include "plan/plan_machine.hpp"
 #include "report/report_as_built.hpp"
 #include "report/report_atoms.hpp"
 
@@ -41,18 +42,16 @@ json field(const json& object, const char* key, json fallback = nullptr) {
 
 // FNV-1a 64 over the solid's lattice and occupied words: equal solids hash equally.
 std::uint64_t solid_hash(const geometry::Solid& solid) {
-  std::uint64_t h = 0xcbf29ce484222325ull;
-  auto mix = [&h](std::uint64_t v) {
-    for (int b = 0; b < 8; ++b) h = (h ^ ((v >> (8 * b)) & 0xff)) * 0x100000001b3ull;
-  };
+  Fnv1a64 h;
+  const auto mix = [&h](std::uint64_t v) { h.update_word(v); };
   const geometry::IndexBox box = solid.bounding_box();
   mix(std::uint64_t(solid.voxel_count()));
-  if (box.empty()) return h;
+  if (box.empty()) return h.value();
   for (int z = box.lo.z; z < box.hi.z; ++z)
     for (int y = box.lo.y; y < box.hi.y; ++y)
       for (int w = solid.first_word(); w < solid.first_word() + solid.words_per_row(); ++w)
         if (const std::uint64_t word = solid.word_at(w, y, z)) mix(word ^ (std::uint64_t(w) << 48) ^ (std::uint64_t(y) << 24) ^ std::uint64_t(z));
-  return h;
+  return h.value();
 }
 
 json toolpath_json(const ActionPath& path) {
@@ -77,8 +76,8 @@ class Gatherer {
  public:
   Gatherer(const ReportRequest& request, ReportData& data)
       : request_(request), data_(data), raw_(read_json(plan_json_path(request.plan), "a plan.json (hybridctl plan -o DIR)")),
-        owned_(request.in_memory ? planner::PlanFile{} : planner::read_plan_file(request.plan)),
-        file_(request.in_memory ? *request.in_memory : owned_), machine_(planner::plan_machine(file_, {}).machine) {}
+        owned_(request.in_memory ? plan::PlanFile{} : plan::read_plan_file(request.plan)),
+        file_(request.in_memory ? *request.in_memory : owned_), machine_(plan::plan_machine(file_, {}).machine) {}
 
   void run() {
     json& doc = data_.document;
@@ -191,14 +190,14 @@ class Gatherer {
     data_.document["verdict"] = verdict;
   }
 
-  json action_entry(const json& raw_action, const planner::PlanFileAction& action) const {
+  json action_entry(const json& raw_action, const plan::PlanFileAction& action) const {
     json entry = raw_action.is_object() ? raw_action : json::object();
     entry.erase("region_atoms");
-    const planner::PlanFilePrimitive& p = file_.primitives.at(std::size_t(action.primitive));
+    const plan::PlanFilePrimitive& p = file_.primitives.at(std::size_t(action.primitive));
     entry["primitive"] = p.name;
     entry["label"] = p.label;
     entry["kind"] = p.kind;
-    entry["mode"] = p.mode == planner::Mode::Additive ? "additive" : "subtractive";
+    entry["mode"] = p.mode == config::Mode::Additive ? "additive" : "subtractive";
     entry["capability"] = p.capability;
     entry["setup"] = p.setup;
     entry["tool_number"] = p.tool_number;
@@ -215,7 +214,7 @@ class Gatherer {
   };
   std::vector<PlanWork> plan_work() const {
     std::vector<std::vector<geometry::Solid>> states(file_.plans.size());
-    tbb::parallel_for(std::size_t(0), states.size(), [&](std::size_t k) { states[k] = planner::plan_states(file_, file_.plans[k]); });
+    tbb::parallel_for(std::size_t(0), states.size(), [&](std::size_t k) { states[k] = plan::plan_states(file_, file_.plans[k]); });
     std::vector<PlanPaths> paths = plan_paths(file_, states, machine_);
     std::vector<PlanWork> work(file_.plans.size());
     for (std::size_t k = 0; k < work.size(); ++k) work[k] = {std::move(states[k]), std::move(paths[k])};
@@ -227,7 +226,7 @@ class Gatherer {
     const json listed = field(raw_, "plans", json::array());
     std::vector<PlanWork> work = plan_work();
     for (std::size_t k = 0; k < file_.plans.size(); ++k) {
-      const planner::PlanFilePlan& plan = file_.plans[k];
+      const plan::PlanFilePlan& plan = file_.plans[k];
       json entry = k < listed.size() ? listed[k] : json::object();
       entry.erase("final_atoms");
       if (!work[k].paths.error.empty()) entry["toolpath_error"] = work[k].paths.error;
@@ -262,8 +261,8 @@ class Gatherer {
   const ReportRequest& request_;
   ReportData& data_;
   json raw_;
-  planner::PlanFile owned_;  // read from the directory when the request holds none
-  const planner::PlanFile& file_;
+  plan::PlanFile owned_;  // read from the directory when the request holds none
+  const plan::PlanFile& file_;
   config::Machine machine_;
   std::vector<geometry::Vec3> line_positions_;
   struct MeshJob {

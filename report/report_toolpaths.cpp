@@ -147,7 +147,7 @@ struct ActionJob {
 
 }  // namespace
 
-std::vector<PlanPaths> plan_paths(const planner::PlanFile& file, const std::vector<std::vector<geometry::Solid>>& states,
+std::vector<PlanPaths> plan_paths(const plan::PlanFile& file, const std::vector<std::vector<geometry::Solid>>& states,
                                   const config::Machine& machine) {
   std::vector<ActionJob> jobs;
   std::map<std::vector<int>, std::size_t> job_of;           // by the primitives up to the action

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "config/machine.hpp"
-#include "planner/plan_file.hpp"
+#include "plan/plan_file.hpp"
 
 namespace hybridctl::report {
 
@@ -45,11 +45,11 @@ struct PlanPaths {
 };
 
 // Every plan's actions with their toolpaths (as toolpaths::export_plan makes them against
-// the planned states) and cycle times; `states[k]` are plan k's (planner::plan_states).
+// the planned states) and cycle times; `states[k]` are plan k's (plan::plan_states).
 // An action depends only on the primitives up to it, so plans that begin alike share
 // their first actions: each distinct one is exported once. The exports run in parallel,
 // the costliest (by the plan's cost of the action) first, so that no long one starts last.
-std::vector<PlanPaths> plan_paths(const planner::PlanFile& file, const std::vector<std::vector<geometry::Solid>>& states,
+std::vector<PlanPaths> plan_paths(const plan::PlanFile& file, const std::vector<std::vector<geometry::Solid>>& states,
                                   const config::Machine& machine);
 
 }  // namespace hybridctl::report

@@ -6,13 +6,13 @@
 
 #include "common/error.hpp"
 #include "instruments/bead.hpp"
-#include "planner/start_stock.hpp"
+#include "plan/start_stock.hpp"
 #include "toolpaths/setup_frame.hpp"
 
 namespace hybridctl::toolpaths {
 namespace {
 
-const config::Setup& setup_named(const config::Machine& m, const planner::PlanFilePrimitive& p) {
+const config::Setup& setup_named(const config::Machine& m, const plan::PlanFilePrimitive& p) {
   for (const auto& s : m.setups)
     if (s.name == p.setup) return s;
   throw InputError(p.name + " (" + p.label + "): the machine '" + m.name + "' has no setup '" + p.setup +
@@ -20,16 +20,16 @@ const config::Setup& setup_named(const config::Machine& m, const planner::PlanFi
 }
 
 // Where the simulated machine has its build plate in `setup`'s work frame: under the
-// lowest voxel layer of the box it works in (planner::simulated_domain; for a plan that
+// lowest voxel layer of the box it works in (plan::simulated_domain; for a plan that
 // starts by depositing, that box starts at the first deposit's lowest layer in its setup).
 // A deposit onto nothing has the plate under its own first layer (the toolpath's default).
-double plate_z(const planner::PlanFile& file, const geometry::IndexBox& simulated, const config::Setup& setup) {
+double plate_z(const plan::PlanFile& file, const geometry::IndexBox& simulated, const config::Setup& setup) {
   return file.lattice.origin.z + part_to_work(simulated, file.lattice, setup.approach).lo.z * file.lattice.voxel_size;
 }
 
 // The action's toolpath from its region of influence in the material it meets.
 // `counted_on`: DepositionOptions::counted_on, or null.
-void make_program(const planner::PlanFile& file, const geometry::IndexBox& simulated, const planner::PlanFilePrimitive& p,
+void make_program(const plan::PlanFile& file, const geometry::IndexBox& simulated, const plan::PlanFilePrimitive& p,
                   const config::Machine& machine, const ExportOptions& options, ExportedAction& a,
                   const geometry::Solid* counted_on) {
   const config::Setup& setup = setup_named(machine, p);
@@ -37,7 +37,7 @@ void make_program(const planner::PlanFile& file, const geometry::IndexBox& simul
   prog.action = a.step;
   prog.primitive = p.name;
   prog.label = p.label;
-  prog.additive = p.mode == planner::Mode::Additive;
+  prog.additive = p.mode == config::Mode::Additive;
   prog.volume = a.roi.volume();
   if (prog.additive) {
     const config::AdditiveHead* head = nullptr;
@@ -88,7 +88,7 @@ std::vector<std::string> path_defects(const PlanExport& exported) {
 
 namespace {
 
-void check_machine(const planner::PlanFile& file, const config::Machine& machine) {
+void check_machine(const plan::PlanFile& file, const config::Machine& machine) {
   if (file.machine_name != machine.name)
     throw InputError("the plan was made for machine '" + file.machine_name + "', not '" + machine.name +
                      "'; expected the machine file it was planned with (" + file.machine_file + ")");
@@ -99,11 +99,11 @@ void check_machine(const planner::PlanFile& file, const config::Machine& machine
 // `planned_before`, with the material fed back: the plan's state before the action, which
 // tells the part of a deposit's ROI the plan counts on it for (DepositionOptions::counted_on).
 ExportedAction make_action(int k, geometry::Solid before, const geometry::Solid* after, const geometry::IndexBox& simulated,
-                           const planner::PlanFile& file, const planner::PlanFilePlan& plan,
+                           const plan::PlanFile& file, const plan::PlanFilePlan& plan,
                            const config::Machine& machine, const ExportOptions& options,
                            const geometry::Solid* planned_before = nullptr) {
-  const planner::PlanFilePrimitive& p = file.primitives.at(std::size_t(plan.actions.at(std::size_t(k)).primitive));
-  const bool additive = p.mode == planner::Mode::Additive;
+  const plan::PlanFilePrimitive& p = file.primitives.at(std::size_t(plan.actions.at(std::size_t(k)).primitive));
+  const bool additive = p.mode == config::Mode::Additive;
   ExportedAction a;
   a.step = k + 1;
   a.primitive = p.name;
@@ -114,7 +114,7 @@ ExportedAction make_action(int k, geometry::Solid before, const geometry::Solid*
     a.note = "clamp the raw stock: " + p.label;
   } else if (a.roi.empty()) {
     a.note = "nothing to " + std::string(additive ? "deposit" : "remove") + " in this state";
-  } else if (p.kind == "file") {
+  } else if (p.kind == config::PrimitiveKind::File) {
     throw InputError(p.name + " is a primitive from the file " + p.capability +
                      ": no head or tool of the machine is known to make it; expected machine primitives only");
   } else {
@@ -130,13 +130,13 @@ ExportedAction make_action(int k, geometry::Solid before, const geometry::Solid*
 // Actions `first`.. of the plan into `out`; `present` is the material the first one meets
 // when the material present is fed back, `planned` the planned states otherwise.
 void export_from(int first, geometry::Solid present, const std::vector<geometry::Solid>& planned,
-                 const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+                 const plan::PlanFile& file, const plan::PlanFilePlan& plan, const config::Machine& machine,
                  const ExportOptions& options, const MaterialAfter& material_after, PlanExport& out) {
   const int n = int(plan.actions.size());
-  const geometry::IndexBox simulated = planner::simulated_domain(file, plan, machine);
+  const geometry::IndexBox simulated = plan::simulated_domain(file, plan, machine);
   for (int k = first; k < n; ++k) {
     if (options.progress) options.progress(k + 1, n);
-    const planner::PlanFilePrimitive& p = file.primitives[std::size_t(plan.actions[std::size_t(k)].primitive)];
+    const plan::PlanFilePrimitive& p = file.primitives[std::size_t(plan.actions[std::size_t(k)].primitive)];
     if (p.raw_stock()) out.raw_stock = p.label;
     const geometry::Solid* planned_before = planned.empty() ? nullptr : &planned[std::size_t(k)];
     ExportedAction a = material_after
@@ -150,16 +150,16 @@ void export_from(int first, geometry::Solid present, const std::vector<geometry:
 
 }  // namespace
 
-PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+PlanExport export_plan(const plan::PlanFile& file, const plan::PlanFilePlan& plan, const config::Machine& machine,
                        const ExportOptions& options, const MaterialAfter& material_after) {
   check_machine(file, machine);
   PlanExport out;
-  const std::vector<geometry::Solid> planned = planner::plan_states(file, plan);
+  const std::vector<geometry::Solid> planned = plan::plan_states(file, plan);
   export_from(0, planned.front(), planned, file, plan, machine, options, material_after, out);
   return out;
 }
 
-PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+PlanExport export_plan(const plan::PlanFile& file, const plan::PlanFilePlan& plan, const config::Machine& machine,
                        const ExportOptions& options, const MaterialAfter& material_after, ExportStart start) {
   if (!material_after) throw std::invalid_argument("export_plan: a start needs material_after");
   if (start.actions.size() > plan.actions.size())
@@ -168,28 +168,28 @@ PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePla
   PlanExport out;
   // The raw stock's label, as the actions of the start set it.
   for (std::size_t k = 0; k < start.actions.size(); ++k) {
-    const planner::PlanFilePrimitive& p = file.primitives.at(std::size_t(plan.actions[k].primitive));
+    const plan::PlanFilePrimitive& p = file.primitives.at(std::size_t(plan.actions[k].primitive));
     if (p.raw_stock()) out.raw_stock = p.label;
   }
   const int first = int(start.actions.size());
   out.actions = std::move(start.actions);
   // The planned states tell what the plan counts on a deposit for: none needed when only
   // removals remain.
-  const bool deposits = std::any_of(plan.actions.begin() + first, plan.actions.end(), [&](const planner::PlanFileAction& a) {
-    return file.primitives.at(std::size_t(a.primitive)).mode == planner::Mode::Additive;
+  const bool deposits = std::any_of(plan.actions.begin() + first, plan.actions.end(), [&](const plan::PlanFileAction& a) {
+    return file.primitives.at(std::size_t(a.primitive)).mode == config::Mode::Additive;
   });
-  export_from(first, std::move(start.present), deposits ? planner::plan_states(file, plan) : std::vector<geometry::Solid>{},
+  export_from(first, std::move(start.present), deposits ? plan::plan_states(file, plan) : std::vector<geometry::Solid>{},
               file, plan, machine, options, material_after, out);
   return out;
 }
 
-ExportedAction export_planned_action(const planner::PlanFile& file, const planner::PlanFilePlan& plan, int k,
+ExportedAction export_planned_action(const plan::PlanFile& file, const plan::PlanFilePlan& plan, int k,
                                      const std::vector<geometry::Solid>& planned, const config::Machine& machine,
                                      const ExportOptions& options) {
   if (k < 0 || std::size_t(k) >= plan.actions.size() || planned.size() != plan.actions.size() + 1)
     throw std::invalid_argument("export_planned_action: no action " + std::to_string(k) + " or not the plan's states");
   check_machine(file, machine);
-  return make_action(k, planned[std::size_t(k)], &planned[std::size_t(k) + 1], planner::simulated_domain(file, plan, machine),
+  return make_action(k, planned[std::size_t(k)], &planned[std::size_t(k) + 1], plan::simulated_domain(file, plan, machine),
                      file, plan, machine, options);
 }
 

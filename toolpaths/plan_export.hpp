@@ -22,7 +22,7 @@
 #include "toolpaths/pocket_path.hpp"
 #include "gcode/post.hpp"
 #include "toolpaths/toolpath.hpp"
-#include "planner/plan_file.hpp"
+#include "plan/plan_file.hpp"
 
 namespace hybridctl::toolpaths {
 
@@ -61,7 +61,7 @@ struct PlanExport {
 // `material_after`, when given, is asked after every action (the raw stock and actions
 // with nothing to do included) and the next action meets what it returns instead of the
 // planned state.
-PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+PlanExport export_plan(const plan::PlanFile& file, const plan::PlanFilePlan& plan, const config::Machine& machine,
                        const ExportOptions& options = {}, const MaterialAfter& material_after = {});
 
 // Where export starts when the first actions of the plan were made before, with the same
@@ -76,14 +76,14 @@ struct ExportStart {
 
 // export_plan from `start`; `material_after` is required (std::invalid_argument otherwise).
 // The actions of `start` come first in the result; progress is called for the others.
-PlanExport export_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+PlanExport export_plan(const plan::PlanFile& file, const plan::PlanFilePlan& plan, const config::Machine& machine,
                        const ExportOptions& options, const MaterialAfter& material_after, ExportStart start);
 
 // Action `k` (0-based) of `plan` as export_plan without material_after makes it: against
-// the planned states `planned` (planner::plan_states(file, plan)). It depends only on the
+// the planned states `planned` (plan::plan_states(file, plan)). It depends only on the
 // actions up to it, so plans that begin alike share it (the report exports each once).
 // std::invalid_argument for a `k` the plan does not have or states that are not its.
-ExportedAction export_planned_action(const planner::PlanFile& file, const planner::PlanFilePlan& plan, int k,
+ExportedAction export_planned_action(const plan::PlanFile& file, const plan::PlanFilePlan& plan, int k,
                                      const std::vector<geometry::Solid>& planned, const config::Machine& machine,
                                      const ExportOptions& options = {});
 

@@ -11,7 +11,7 @@
 #include "common/error.hpp"
 #include "common/number_text.hpp"
 #include "gcode/post.hpp"
-#include "planner/start_stock.hpp"
+#include "plan/start_stock.hpp"
 #include "sim/executor.hpp"
 #include "validation/prefix_cache.hpp"
 
@@ -22,7 +22,7 @@ using geometry::Solid;
 
 // `s` on the plan's lattice with the plan's domain as its storage: the simulated world is
 // the domain planning looked at, so deposit beyond the raw stock's box is not lost.
-Solid on_domain(const Solid& s, const planner::PlanFile& file) {
+Solid on_domain(const Solid& s, const plan::PlanFile& file) {
   Solid out(file.lattice, file.domain);
   const geometry::IndexBox& d = file.domain;
   const geometry::IndexBox rows = geometry::box_intersection(s.storage_box(), d);
@@ -83,7 +83,7 @@ struct PrefixCacheImpl {
   PrefixCacheStats stats;
   std::list<Entry> lru;  // front: most recently used
   std::map<std::vector<int>, std::list<Entry>::iterator> index;
-  const planner::PlanFile* file = nullptr;
+  const plan::PlanFile* file = nullptr;
   const config::Machine* machine = nullptr;
   std::optional<Solid> core;  // the file's design shrunk by its tolerance, once
 
@@ -95,7 +95,7 @@ struct PrefixCacheImpl {
     core.reset();
   }
   // Empties the cache when it is asked about another file or machine than the last.
-  void serve(const planner::PlanFile& f, const config::Machine& m) {
+  void serve(const plan::PlanFile& f, const config::Machine& m) {
     if (file == &f && machine == &m) return;
     clear();
     file = &f;
@@ -151,9 +151,9 @@ void PrefixCache::clear() { impl_->clear(); }
 namespace {
 
 // The step of the plan's last action that adds material, the raw stock included (0: none).
-int last_addition(const planner::PlanFile& file, const planner::PlanFilePlan& plan) {
+int last_addition(const plan::PlanFile& file, const plan::PlanFilePlan& plan) {
   for (std::size_t k = plan.actions.size(); k > 0; --k)
-    if (file.primitives.at(std::size_t(plan.actions[k - 1].primitive)).mode == planner::Mode::Additive) return int(k);
+    if (file.primitives.at(std::size_t(plan.actions[k - 1].primitive)).mode == config::Mode::Additive) return int(k);
   return 0;
 }
 
@@ -180,7 +180,7 @@ std::optional<geometry::Vec3> central_voxel(const Solid& voxels) {
 // carry its line numbers.
 class IncrementalRun {
  public:
-  IncrementalRun(const config::Machine& machine, const planner::PlanFile& file, const planner::PlanFilePlan& plan,
+  IncrementalRun(const config::Machine& machine, const plan::PlanFile& file, const plan::PlanFilePlan& plan,
                  Solid start, const ExecutionOptions& options)
       : machine_(machine),
         file_(file),
@@ -189,7 +189,7 @@ class IncrementalRun {
         executor_(machine, "plan", executor_options(file, start, options)) {}
 
   // Going on after a prefix of `plan` run before (same file, machine and options).
-  IncrementalRun(const config::Machine& machine, const planner::PlanFile& file, const planner::PlanFilePlan& plan,
+  IncrementalRun(const config::Machine& machine, const plan::PlanFile& file, const plan::PlanFilePlan& plan,
                  const PrefixState& from, const ExecutionOptions& options)
       : machine_(machine),
         file_(file),
@@ -221,8 +221,8 @@ class IncrementalRun {
     if (missing.empty()) return;
     const std::optional<geometry::Vec3> where = central_voxel(missing);
     const int last = last_addition();
-    const planner::PlanFilePrimitive& p = file_.primitives.at(std::size_t(plan_.actions.at(std::size_t(last - 1)).primitive));
-    throw Stopped{step, planner::RejectionReason{
+    const plan::PlanFilePrimitive& p = file_.primitives.at(std::size_t(plan_.actions.at(std::size_t(last - 1)).primitive));
+    throw Stopped{step, plan::RejectionReason{
                             "missing_material", last, 0,
                             "after action " + std::to_string(last) + " (" + p.name +
                                 "), the last that adds material, " + fixed_number(missing.volume(), 1) +
@@ -267,7 +267,7 @@ class IncrementalRun {
   // the core missing after the last addition (check_core_after).
   struct Stopped {
     int action = 0;
-    std::optional<planner::RejectionReason> missing;
+    std::optional<plan::RejectionReason> missing;
   };
 
   // Stopped early: what ran so far.
@@ -292,11 +292,11 @@ class IncrementalRun {
   }
 
  private:
-  static sim::ExecutorOptions executor_options(const planner::PlanFile& file, Solid start,
+  static sim::ExecutorOptions executor_options(const plan::PlanFile& file, Solid start,
                                                const ExecutionOptions& options) {
     sim::ExecutorOptions o;
     o.stock = std::move(start);
-    o.protected_region = planner::spared_by_cuts(file);  // the header's lines, before any action
+    o.protected_region = plan::spared_by_cuts(file);  // the header's lines, before any action
     o.simulation = options.simulation;
     return o;
   }
@@ -325,23 +325,23 @@ class IncrementalRun {
   void protect_for(const gcode::ProgramAction* action) {
     if (!action || action->number == protecting_) return;
     protecting_ = action->number;
-    const planner::PlanFilePrimitive& p =
+    const plan::PlanFilePrimitive& p =
         file_.primitives.at(std::size_t(plan_.actions.at(std::size_t(action->number - 1)).primitive));
-    executor_.set_protected_region(planner::spared_by_cuts(file_, &p));
+    executor_.set_protected_region(plan::spared_by_cuts(file_, &p));
   }
 
   const Solid& design_core() {
     if (cache_) {
-      if (!cache_->core) cache_->core = planner::spared_by_cuts(file_);
+      if (!cache_->core) cache_->core = plan::spared_by_cuts(file_);
       return *cache_->core;
     }
-    if (!core_) core_ = planner::spared_by_cuts(file_);
+    if (!core_) core_ = plan::spared_by_cuts(file_);
     return *core_;
   }
 
   const config::Machine& machine_;
-  const planner::PlanFile& file_;
-  const planner::PlanFilePlan& plan_;
+  const plan::PlanFile& file_;
+  const plan::PlanFilePlan& plan_;
   const ExecutionOptions& options_;
   sim::ProgramExecutor executor_;
   std::vector<gcode::ActionProgram> made_;
@@ -357,7 +357,7 @@ class IncrementalRun {
 };
 
 // Exports and executes `plan` with `run`, from `start` when it resumes a prefix.
-Execution run_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+Execution run_plan(const plan::PlanFile& file, const plan::PlanFilePlan& plan, const config::Machine& machine,
                    const ExecutionOptions& options, IncrementalRun& run, std::optional<toolpaths::ExportStart> start) {
   Execution out;
   if (options.planned_against == PlannedAgainst::MaterialPresent) {
@@ -382,20 +382,20 @@ Execution run_plan(const planner::PlanFile& file, const planner::PlanFilePlan& p
     run.take(out.exported.programs());
   }
   out.program = run.finish(out);
-  out.deviation = planner::measure_deviation(out.as_built, file.design, file.domain, file.tolerance);
+  out.deviation = plan::measure_deviation(out.as_built, file.design, file.domain, file.tolerance);
   out.reasons = rejection_reasons(out, file, machine);
   return out;
 }
 
 }  // namespace
 
-Execution execute_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+Execution execute_plan(const plan::PlanFile& file, const plan::PlanFilePlan& plan, const config::Machine& machine,
                        const ExecutionOptions& options) {
-  IncrementalRun run(machine, file, plan, planner::start_stock(file, plan, machine), options);
+  IncrementalRun run(machine, file, plan, plan::start_stock(file, plan, machine), options);
   return run_plan(file, plan, machine, options, run, std::nullopt);
 }
 
-Execution execute_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+Execution execute_plan(const plan::PlanFile& file, const plan::PlanFilePlan& plan, const config::Machine& machine,
                        const ExecutionOptions& options, PrefixCache* cache) {
   // The planned state does not depend on what the simulation holds: nothing to resume.
   if (!cache || options.planned_against != PlannedAgainst::MaterialPresent)
@@ -403,7 +403,7 @@ Execution execute_plan(const planner::PlanFile& file, const planner::PlanFilePla
   detail::PrefixCacheImpl& c = cache->impl();
   c.serve(file, machine);
   std::vector<int> key;
-  for (const planner::PlanFileAction& a : plan.actions) key.push_back(a.primitive);
+  for (const plan::PlanFileAction& a : plan.actions) key.push_back(a.primitive);
   const PrefixState* from = c.longest(key);
   if (from && options.run_until == RunUntil::FirstFailingAction) {
     // From the raw stock, the run stops after the last addition when the design's core is
@@ -411,7 +411,7 @@ Execution execute_plan(const planner::PlanFile& file, const planner::PlanFilePla
     // from that addition at the latest, so that the run ends the same.
     const std::size_t last = std::size_t(last_addition(file, plan));
     if (from->actions.size() > last) {
-      if (!c.core) c.core = planner::spared_by_cuts(file);
+      if (!c.core) c.core = plan::spared_by_cuts(file);
       if (!subtract(*c.core, IncrementalRun(machine, file, plan, *from, options).present()).empty()) {
         // One lookup, counted as the one that resumes.
         --c.stats.lookups;
@@ -428,7 +428,7 @@ Execution execute_plan(const planner::PlanFile& file, const planner::PlanFilePla
     toolpaths::ExportStart start{from->actions, run.present()};
     return run_plan(file, plan, machine, options, run, std::move(start));
   }
-  IncrementalRun run(machine, file, plan, planner::start_stock(file, plan, machine), options);
+  IncrementalRun run(machine, file, plan, plan::start_stock(file, plan, machine), options);
   run.keep_in(&c);
   return run_plan(file, plan, machine, options, run, std::nullopt);
 }

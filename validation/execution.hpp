@@ -8,7 +8,7 @@
 // not make the part, if any.
 //
 //   const validation::Execution run = validation::execute_plan(file, file.plans[0], machine);
-//   if (!run.proven()) for (const auto& r : run.reasons) ... planner::describe(r) ...
+//   if (!run.proven()) for (const auto& r : run.reasons) ... plan::describe(r) ...
 //
 // This library sits above the planner, toolpaths and sim (docs/architecture.md): the
 // planner offers it candidates through PlanningOptions::validate (validation/plan_validator.hpp).
@@ -20,9 +20,9 @@
 #include "config/machine.hpp"
 #include "gcode/program.hpp"
 #include "geometry/solid.hpp"
-#include "planner/deviation.hpp"
-#include "planner/plan_file.hpp"
-#include "planner/rejection.hpp"
+#include "plan/deviation.hpp"
+#include "plan/plan_file.hpp"
+#include "plan/rejection.hpp"
 #include "sim/material.hpp"
 #include "toolpaths/plan_export.hpp"
 #include "validation/prefix_cache.hpp"
@@ -65,8 +65,8 @@ struct Execution {
   geometry::Solid as_built;            // part frame, the plan's lattice and domain
   sim::SimulationReport report;        // incidents carry the program's lines
   std::vector<std::string> errors;     // lines the machine refused (G-code, envelope, interlocks)
-  planner::Deviation deviation;        // as built against the design
-  std::vector<planner::RejectionReason> reasons;  // empty: the plan makes the part
+  plan::Deviation deviation;        // as built against the design
+  std::vector<plan::RejectionReason> reasons;  // empty: the plan makes the part
   int stopped_after = 0;  // RunUntil::FirstFailingAction: the action it stopped after (0: ran to the end)
   // Stopped after the plan's last action that adds material, with part of the design's
   // core (the design shrunk by the tolerance) missing: removals alone cannot put it back,
@@ -77,13 +77,13 @@ struct Execution {
 
 // Exports and executes `plan` of `file` on `machine` from its raw stock (an empty stock on
 // the plan's domain when it starts with deposition). Each action's lines spare what the
-// action keeps of the design, shrunk by the tolerance (planner::spared_by_cuts; a cut into
+// action keeps of the design, shrunk by the tolerance (plan::spared_by_cuts; a cut into
 // it is a gouge): a removal's own region may take design material a later deposit builds
 // again, and the deviation judges the part as built. Throws
 // InputError when an action cannot be written for the machine (another machine, an
 // instrument it lacks, a move beyond its envelope), as toolpaths::export_plan and
 // gcode::post_program do.
-Execution execute_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+Execution execute_plan(const plan::PlanFile& file, const plan::PlanFilePlan& plan, const config::Machine& machine,
                        const ExecutionOptions& options = {});
 
 // execute_plan resumed from the longest prefix of `plan` that `cache` holds, keeping the
@@ -91,26 +91,26 @@ Execution execute_plan(const planner::PlanFile& file, const planner::PlanFilePla
 // Execution as from the raw stock (reasons, lines, program, as built, report), but for the
 // solids of the resumed actions in `exported`. `cache` serves one file, machine and
 // options; null, or PlannedAgainst::PlannedState, executes from the raw stock.
-Execution execute_plan(const planner::PlanFile& file, const planner::PlanFilePlan& plan, const config::Machine& machine,
+Execution execute_plan(const plan::PlanFile& file, const plan::PlanFilePlan& plan, const config::Machine& machine,
                        const ExecutionOptions& options, PrefixCache* cache);
 
 // The reasons of an execution, as execute_plan fills `reasons`: the toolpaths' defects
 // (layer skipped, region unreachable), every incident kind per action (rapid into
 // material, body collision, gouge, unsupported deposit, ...), refused lines, and the part
 // as built outside the tolerance (missing or excess material).
-std::vector<planner::RejectionReason> rejection_reasons(const Execution& execution, const planner::PlanFile& file,
+std::vector<plan::RejectionReason> rejection_reasons(const Execution& execution, const plan::PlanFile& file,
                                                         const config::Machine& machine);
 
 // plan.json's name for an incident kind ("rapid_into_material", "body_collision", ...).
 std::string reason_kind(sim::IncidentKind kind);
 
 // The reasons as lines for people, at most `shown` of them and a count of the rest.
-std::string describe_reasons(const std::vector<planner::RejectionReason>& reasons, std::size_t shown = 20);
+std::string describe_reasons(const std::vector<plan::RejectionReason>& reasons, std::size_t shown = 20);
 
 // execute_plan, and a NotManufacturableError (exit 4) naming `what` ("plan 2 (expr)") and
 // every reason when there is any (the plan does not make its part, or is unsafe to run):
 // export and run write or stream nothing then.
-Execution require_proven(const planner::PlanFile& file, const planner::PlanFilePlan& plan,
+Execution require_proven(const plan::PlanFile& file, const plan::PlanFilePlan& plan,
                          const config::Machine& machine, const ExecutionOptions& options, const std::string& what);
 
 }  // namespace hybridctl::validation

@@ -9,12 +9,12 @@
 #include "gcode/check.hpp"
 #include "gcode/post.hpp"
 #include "planner/plan_report.hpp"
-#include "planner/start_stock.hpp"
+#include "plan/start_stock.hpp"
 
 namespace hybridctl::validation {
 
-planner::PlanFilePlan candidate_plan(const planner::PlanningResult& r, const planner::Plan& plan) {
-  planner::PlanFilePlan out{0, planner::expression(r.problem, plan), plan.cost, {}};
+plan::PlanFilePlan candidate_plan(const planner::PlanningResult& r, const planner::Plan& plan) {
+  plan::PlanFilePlan out{0, planner::expression(r.problem, plan), plan.cost, {}};
   for (const planner::PlanStep& step : plan.steps) out.actions.push_back({step.primitive, step.volume, step.cost});
   return out;
 }
@@ -53,20 +53,20 @@ PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions option
                          std::shared_ptr<ToolpathTimes> times) {
   struct State {
     ExecutionOptions options;
-    std::optional<planner::PlanFile> file;  // the planning result's grid, design and primitives
+    std::optional<plan::PlanFile> file;  // the planning result's grid, design and primitives
     // Execution is deterministic and an action depends only on the ones before it: a
     // candidate that begins with the actions a rejected one failed in fails the same way;
     // one that failed for the core missing after its last addition, so long as the
     // candidate only removes after them (Execution::missing_after_last_addition).
     struct FailedPrefix {
       std::vector<int> primitives;
-      std::vector<planner::RejectionReason> reasons;
+      std::vector<plan::RejectionReason> reasons;
       bool only_if_removals_follow = false;
     };
     std::vector<FailedPrefix> failed_prefixes;
     // ... and the same holds for the prefixes that went right: candidates go on from there.
     std::shared_ptr<PrefixCache> cache;
-    std::optional<geometry::Solid> core;  // the design's core (planner::spared_by_cuts), once
+    std::optional<geometry::Solid> core;  // the design's core (plan::spared_by_cuts), once
   };
   // A candidate is rejected at its first failing action: its first reasons are enough.
   options.run_until = RunUntil::FirstFailingAction;
@@ -79,14 +79,14 @@ PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions option
       const planner::ReportSources sources{"", "", machine.name, ""};
       state->file = planner::to_plan_file(r, sources, ".");
     }
-    const planner::PlanFilePlan candidate = candidate_plan(r, plan);
-    const auto removes = [&](const planner::PlanFileAction& a) {
-      return state->file->primitives.at(std::size_t(a.primitive)).mode == planner::Mode::Subtractive;
+    const plan::PlanFilePlan candidate = candidate_plan(r, plan);
+    const auto removes = [&](const plan::PlanFileAction& a) {
+      return state->file->primitives.at(std::size_t(a.primitive)).mode == config::Mode::Subtractive;
     };
     for (const State::FailedPrefix& failed : state->failed_prefixes)
       if (failed.primitives.size() <= candidate.actions.size() &&
           std::equal(failed.primitives.begin(), failed.primitives.end(), candidate.actions.begin(),
-                     [](int p, const planner::PlanFileAction& a) { return p == a.primitive; }) &&
+                     [](int p, const plan::PlanFileAction& a) { return p == a.primitive; }) &&
           (!failed.only_if_removals_follow ||
            std::all_of(candidate.actions.begin() + std::ptrdiff_t(failed.primitives.size()), candidate.actions.end(), removes)))
         return planner::CandidateCheck{failed.reasons};
@@ -99,14 +99,14 @@ PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions option
       }
       if (times && run.proven() && run.exported.actions.size() == candidate.actions.size()) {
         std::vector<int> key;
-        for (const planner::PlanFileAction& a : candidate.actions) key.push_back(a.primitive);
+        for (const plan::PlanFileAction& a : candidate.actions) key.push_back(a.primitive);
         (*times)[key] = action_minutes(run, machine);
       }
       if (run.proven()) return planner::CandidateCheck{};
       const std::size_t executed = run.stopped_after > 0 ? std::size_t(run.stopped_after) : plan.steps.size();
       std::vector<planner::Shortfall> shortfalls = planner::find_shortfalls(r.problem, r.atoms, plan, executed, run.as_built);
       if (shortfalls.empty() && run.missing_after_last_addition) {
-        if (!state->core) state->core = planner::spared_by_cuts(*state->file);
+        if (!state->core) state->core = plan::spared_by_cuts(*state->file);
         shortfalls = planner::find_missing_core_shortfalls(r.problem, r.atoms, plan, executed,
                                                            geometry::subtract(*state->core, run.as_built));
       }

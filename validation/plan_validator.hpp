@@ -39,6 +39,6 @@ PlanCheck plan_validator(const config::Machine& machine, ExecutionOptions option
 void use_validation(planner::PlanningOptions& options, const config::Machine& machine);
 
 // One candidate of a planning result as the plan file names it (rank 0).
-planner::PlanFilePlan candidate_plan(const planner::PlanningResult& result, const planner::Plan& plan);
+plan::PlanFilePlan candidate_plan(const planner::PlanningResult& result, const planner::Plan& plan);
 
 }  // namespace hybridctl::validation

@@ -14,7 +14,7 @@
 namespace hybridctl::validation {
 namespace {
 
-using planner::RejectionReason;
+using plan::RejectionReason;
 
 const config::Setup* setup_named(const config::Machine& machine, const std::string& name) {
   for (const config::Setup& s : machine.setups)
@@ -69,7 +69,7 @@ void add_incidents(const Execution& run, const config::Machine& machine, std::ve
 
 // The part as built against the design, both ways, with the tolerance.
 void add_deviation(const Execution& run, double tolerance, std::vector<RejectionReason>& out) {
-  const planner::Deviation& d = run.deviation;
+  const plan::Deviation& d = run.deviation;
   if (d.within_tolerance) return;
   // The two-sided test that decides `within_tolerance` (planner/deviation.hpp) names the
   // reasons: a fin left out leaves few voxels empty, none deep, yet the design's surface at
@@ -111,12 +111,12 @@ std::string reason_kind(sim::IncidentKind kind) {
 std::string describe_reasons(const std::vector<RejectionReason>& reasons, std::size_t shown) {
   std::string out;
   for (std::size_t i = 0; i < reasons.size() && i < shown; ++i)
-    out += "  " + reasons[i].kind + ": " + planner::describe(reasons[i]) + "\n";
+    out += "  " + reasons[i].kind + ": " + plan::describe(reasons[i]) + "\n";
   if (reasons.size() > shown) out += "  ... and " + std::to_string(reasons.size() - shown) + " more\n";
   return out;
 }
 
-Execution require_proven(const planner::PlanFile& file, const planner::PlanFilePlan& plan,
+Execution require_proven(const plan::PlanFile& file, const plan::PlanFilePlan& plan,
                          const config::Machine& machine, const ExecutionOptions& options, const std::string& what) {
   Execution run = execute_plan(file, plan, machine, options);
   // Every reason refuses: a path that skips what it should make, a rapid or a body into
@@ -131,7 +131,7 @@ Execution require_proven(const planner::PlanFile& file, const planner::PlanFileP
   return run;
 }
 
-std::vector<RejectionReason> rejection_reasons(const Execution& run, const planner::PlanFile& file,
+std::vector<RejectionReason> rejection_reasons(const Execution& run, const plan::PlanFile& file,
                                                const config::Machine& machine) {
   std::vector<RejectionReason> out;
   add_path_defects(run, machine, out);

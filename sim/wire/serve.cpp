@@ -10,14 +10,14 @@
 
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
-#include "planner/start_stock.hpp"
+#include "plan/start_stock.hpp"
 #include "config/transport_uri.hpp"
 #include "geometry/memory_estimate.hpp"
 #include "geometry/mesh.hpp"
 #include "geometry/morphology.hpp"
 #include "geometry/surface_mesh.hpp"
 #include "geometry/vdb_file.hpp"
-#include "planner/plan_file.hpp"
+#include "plan/plan_file.hpp"
 #include "protocol/can_transfer.hpp"
 #include "protocol/modbus_map.hpp"
 #include "sim/wire/modbus_server.hpp"
@@ -92,19 +92,19 @@ CheckedOptions check_options(const ServeOptions& o) {
 // first action's primitive when it is a raw stock (else an empty stock), on the plan's
 // domain, and the design shrunk by the tolerance. Returns what the stock is, for the report.
 std::string stock_from_plan(const ServeOptions& o, const config::Machine& machine, ControllerOptions& options) {
-  const planner::PlanFile file = planner::read_plan_file(o.stock_plan);
+  const plan::PlanFile file = plan::read_plan_file(o.stock_plan);
   if (file.plans.empty()) throw InputError(o.stock_plan + ": the plan file holds no plans (the part was not manufacturable)");
   if (o.plan < 1 || o.plan > int(file.plans.size())) {
     throw InputError("--plan " + std::to_string(o.plan) + ": expected 1.." + std::to_string(file.plans.size()) +
                      " (the plans in " + o.stock_plan + ")");
   }
-  const planner::PlanFilePlan& plan = file.plans[std::size_t(o.plan - 1)];
-  const planner::PlanFilePrimitive* first =
+  const plan::PlanFilePlan& plan = file.plans[std::size_t(o.plan - 1)];
+  const plan::PlanFilePrimitive* first =
       plan.actions.empty() ? nullptr : &file.primitives.at(std::size_t(plan.actions.front().primitive));
   std::string described;
   // As validation executes plans (planner/start_stock.hpp): over the plan's domain, the
   // build plate under the first deposit of a plan that starts with deposition.
-  options.stock = planner::start_stock(file, plan, machine);
+  options.stock = plan::start_stock(file, plan, machine);
   if (first && first->raw_stock()) {
     described = "raw stock " + first->name + " (" + first->capability + ") of plan " + std::to_string(o.plan);
   } else {
@@ -112,7 +112,7 @@ std::string stock_from_plan(const ServeOptions& o, const config::Machine& machin
   }
   // The whole design shrunk by the tolerance: the controller does not follow which action
   // a line belongs to, so a removal the plan refills later (SM-cons) counts as gouge here.
-  options.protected_region = planner::spared_by_cuts(file);
+  options.protected_region = plan::spared_by_cuts(file);
   return described;
 }
 
@@ -121,7 +121,7 @@ std::string stock_from_plan(const ServeOptions& o, const config::Machine& machin
 void check_stock_memory(const ServeOptions& o) {
   const std::uint64_t budget = o.memory_budget ? o.memory_budget : geometry::default_memory_budget();
   if (!o.stock_plan.empty()) {
-    const planner::PlanGrid grid = planner::read_plan_grid(o.stock_plan);
+    const plan::PlanGrid grid = plan::read_plan_grid(o.stock_plan);
     const geometry::Box3 region = grid.lattice.extent(grid.domain);
     // The plan as read (design and every primitive), the stock, the spared region and the
     // controller's material: dense solids over the plan's domain.

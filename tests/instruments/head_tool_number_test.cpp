@@ -8,7 +8,7 @@
 
 #include "config/machine_loader.hpp"
 #include "geometry/shapes.hpp"
-#include "planner/plan_file.hpp"
+#include "plan/plan_file.hpp"
 #include "sim/executor.hpp"
 #include "toolpaths/plan_export.hpp"
 
@@ -38,21 +38,21 @@ TEST(HeadToolNumber, TheMachineLoaderNumbersHeadsTheSameWay) {
 }
 
 // A plan of one deposition by head `head` of a small block, for machine `m`.
-planner::PlanFile one_deposition(const config::Machine& m, const std::string& head) {
-  planner::PlanFile f;
+plan::PlanFile one_deposition(const config::Machine& m, const std::string& head) {
+  plan::PlanFile f;
   f.machine_name = m.name;
   f.lattice = {1.0, {0, 0, 0}};
   f.domain = {{0, 0, 0}, {20, 20, 10}};
-  planner::PlanFilePrimitive p;
+  plan::PlanFilePrimitive p;
   p.name = "P1";
   p.label = "U-AM " + head;
-  p.kind = "u-am";
-  p.mode = planner::Mode::Additive;
+  p.kind = config::PrimitiveKind::UAm;
+  p.mode = config::Mode::Additive;
   p.capability = head;
   p.setup = m.setups.front().name;
   p.region = geometry::make_box(f.lattice, {{2, 2, 0}, {12, 12, 3}});
   f.primitives.push_back(p);
-  planner::PlanFilePlan plan;
+  plan::PlanFilePlan plan;
   plan.actions.push_back({0, p.region.volume(), 1});
   f.plans.push_back(plan);
   return f;
@@ -65,7 +65,7 @@ TEST(HeadToolNumber, PlanExportAndTheSimulatedMachineSelectAHeadByTheSameNumber)
   for (std::size_t i = 0; i < m.heads.size(); ++i) {
     SCOPED_TRACE(m.heads[i].name);
     const int number = head_tool_number(m, i);
-    const planner::PlanFile f = one_deposition(m, m.heads[i].name);
+    const plan::PlanFile f = one_deposition(m, m.heads[i].name);
     const toolpaths::PlanExport e = toolpaths::export_plan(f, f.plans.front(), m);
     ASSERT_EQ(e.actions.size(), 1u);
     ASSERT_TRUE(e.actions[0].makes_gcode);

@@ -7,7 +7,7 @@
 
 #include "geometry/shapes.hpp"
 #include "planner/atoms.hpp"
-#include "planner/deviation.hpp"
+#include "plan/deviation.hpp"
 #include "planner_fixtures.hpp"
 
 namespace hybridctl::planner {
@@ -146,7 +146,7 @@ TEST(Atoms, AThinFinIsMustInSoAPlanWithoutItIsNoGoal) {
   for (const Plan& plan : plans) {
     const Solid made = testing::evaluate(vp, plan);
     EXPECT_TRUE(subtract(fin, made).empty()) << expression(vp.problem, plan);
-    EXPECT_TRUE(measure_deviation(made, design, domain, 1.0).within_tolerance) << expression(vp.problem, plan);
+    EXPECT_TRUE(plan::measure_deviation(made, design, domain, 1.0).within_tolerance) << expression(vp.problem, plan);
   }
 }
 
@@ -165,7 +165,7 @@ TEST(Atoms, ANarrowSlotIsMustOutSoAPlanThatFillsItIsNoGoal) {
   for (const Plan& plan : plans) {
     const Solid made = testing::evaluate(vp, plan);
     EXPECT_TRUE(intersect(slot, made).empty()) << expression(vp.problem, plan);
-    EXPECT_TRUE(measure_deviation(made, design, domain, 1.0).within_tolerance) << expression(vp.problem, plan);
+    EXPECT_TRUE(plan::measure_deviation(made, design, domain, 1.0).within_tolerance) << expression(vp.problem, plan);
   }
 }
 

@@ -10,8 +10,8 @@
 
 #include "config/machine_loader.hpp"
 #include "geometry/mesh.hpp"
-#include "planner/plan_file.hpp"
-#include "planner/plan_machine.hpp"
+#include "plan/plan_file.hpp"
+#include "plan/plan_machine.hpp"
 #include "planner/plan_report.hpp"
 
 namespace hybridctl::planner {
@@ -38,14 +38,14 @@ TEST(PlanInMemory, EqualsThePlanReadBackFromItsDirectory) {
   const ReportSources sources{"flanged-hub.stl", "hybrid-3axis.yaml", machine.name, machine_text};
   const fs::path dir = fs::temp_directory_path() / ("hybridctl-plan-in-memory-" + std::to_string(::getpid()));
   write_plan_directory(result, sources, dir);
-  const PlanFile disk = read_plan_file(dir);
+  const plan::PlanFile disk = plan::read_plan_file(dir);
   fs::remove_all(dir);
 
-  const PlanFile memory = to_plan_file(result, sources, dir);
+  const plan::PlanFile memory = to_plan_file(result, sources, dir);
   EXPECT_TRUE(memory == disk);
   EXPECT_EQ(memory.directory, disk.directory);
   EXPECT_EQ(memory.machine_yaml, machine_text);
-  EXPECT_EQ(disk.machine_hash, machine_text_hash(machine_text));
+  EXPECT_EQ(disk.machine_hash, plan::machine_text_hash(machine_text));
   EXPECT_EQ(memory.part, disk.part);
   EXPECT_EQ(memory.lattice, disk.lattice);
   EXPECT_EQ(memory.domain, disk.domain);
@@ -81,9 +81,9 @@ TEST(PlanInMemory, RejectedCandidatesAreKeptWithTheirReasonsAndReadBack) {
   options.validate = [&offered](const PlanningResult&, const Plan&) {
     // The two cheapest candidates fail, located and not.
     ++offered;
-    if (offered == 1) return std::vector<RejectionReason>{{"gouge", 2, 6112, "a cut into the core", geometry::Vec3{1.5, 2.25, 3}}};
-    if (offered == 2) return std::vector<RejectionReason>{{"missing_material", 0, 0, "the fin is missing", std::nullopt}};
-    return std::vector<RejectionReason>{};
+    if (offered == 1) return std::vector<plan::RejectionReason>{{"gouge", 2, 6112, "a cut into the core", geometry::Vec3{1.5, 2.25, 3}}};
+    if (offered == 2) return std::vector<plan::RejectionReason>{{"missing_material", 0, 0, "the fin is missing", std::nullopt}};
+    return std::vector<plan::RejectionReason>{};
   };
   const PlanningResult result = plan_part(part, "flanged-hub.stl", machine, options);
   EXPECT_TRUE(result.validated);
@@ -97,9 +97,9 @@ TEST(PlanInMemory, RejectedCandidatesAreKeptWithTheirReasonsAndReadBack) {
   const ReportSources sources{"flanged-hub.stl", "hybrid-3axis.yaml", machine.name, machine_text};
   const fs::path dir = fs::temp_directory_path() / ("hybridctl-plan-rejected-" + std::to_string(::getpid()));
   write_plan_directory(result, sources, dir);
-  const PlanFile disk = read_plan_file(dir);
+  const plan::PlanFile disk = plan::read_plan_file(dir);
   fs::remove_all(dir);
-  const PlanFile memory = to_plan_file(result, sources, dir);
+  const plan::PlanFile memory = to_plan_file(result, sources, dir);
   EXPECT_TRUE(memory == disk);
   ASSERT_EQ(disk.rejected.size(), 2u);
   EXPECT_EQ(disk.rejected[0].reasons, result.rejected[0].reasons);

@@ -117,13 +117,13 @@ TEST(Shortfall, CoreMissingAfterTheAdditionsIsChargedToTheDepositThatLaidItsAtom
 TEST(Shortfall, ALayerTheLastActionSkippedChargesTheAtomsMissingWhereTheToolpathSaid) {
   const Row row;
   const Solid built = geometry::unite(voxels(0, 2), voxels(3, 4));  // voxel 2 not laid
-  const RejectionReason skipped{"layer_skipped", 2, 0, "layer 3 ... skipped", geometry::Vec3{2.5, 0.5, 0.5}};
+  const plan::RejectionReason skipped{"layer_skipped", 2, 0, "layer 3 ... skipped", geometry::Vec3{2.5, 0.5, 0.5}};
   std::vector<Shortfall> found =
       find_skipped_layer_shortfalls(row.problem, row.atoms, row.plan({2, 0}), 2, built, {skipped});
   ASSERT_EQ(found.size(), 1u);
   EXPECT_EQ(found[0], (Shortfall{0, row.atom_at(2), row.problem.atoms[std::size_t(row.atom_at(2))].volume}));
   // Another action's skip, another kind of reason, or nothing missing near it: nothing.
-  RejectionReason other = skipped;
+  plan::RejectionReason other = skipped;
   other.action = 1;
   EXPECT_TRUE(find_skipped_layer_shortfalls(row.problem, row.atoms, row.plan({2, 0}), 2, built, {other}).empty());
   other = skipped;
@@ -155,7 +155,7 @@ TEST(Shortfall, ADepositThatLeavesMaterialWhereNoRemovalSparingTheDesignReachesS
   EXPECT_EQ(found[0], (Shortfall{0, beside, 2.0, true}));
   // Half of it: only where validation says the part is worst.
   EXPECT_TRUE(find_spills(row.problem, row.atoms, row.plan({2, 0}), 2, voxels(0, 4), {}).empty());
-  const RejectionReason worst{"excess_material", 0, 0, "as built, ...", geometry::Vec3{3.5, 0.5, 0.5}};
+  const plan::RejectionReason worst{"excess_material", 0, 0, "as built, ...", geometry::Vec3{3.5, 0.5, 0.5}};
   found = find_spills(row.problem, row.atoms, row.plan({2, 0}), 2, voxels(0, 4), {worst});
   ASSERT_EQ(found.size(), 1u);
   EXPECT_EQ(found[0].atom, beside);

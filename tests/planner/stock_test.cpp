@@ -89,4 +89,4 @@ TEST(StockFile, AStockAwayFromThePartIsRefusedSayingWhere) {
 }
 
 }  // namespace
-}  // namespace hybridctl::planner
+}  // namespace hybridctl::plan

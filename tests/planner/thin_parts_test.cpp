@@ -1,6 +1,6 @@
 // planner::mark_thin_parts (through measure_atoms): the atoms thin features and narrow
 // gaps force in or out, such that every goal outcome (every must-in atom, no must-out
-// atom) is within the tolerance both ways as planner::measure_deviation measures it.
+// atom) is within the tolerance both ways as plan::measure_deviation measures it.
 // First with every voxel its own atom (the finest classification there is), then with
 // atoms of random primitives, then the one exception, slivers.
 
@@ -11,7 +11,7 @@
 #include <random>
 
 #include "geometry/shapes.hpp"
-#include "planner/deviation.hpp"
+#include "plan/deviation.hpp"
 
 namespace hybridctl::planner {
 namespace {
@@ -75,7 +75,7 @@ TEST(ThinParts, WithEveryVoxelItsOwnAtomTheFinStaysAndTheSlotStaysOpen) {
     EXPECT_GT(kept, 0);
     EXPECT_GT(cleared, 0);
     for (double p : {0.0, 0.5, 1.0}) {
-      const Deviation d = measure_deviation(goal_outcome(atoms, m, rng, p), design, kDomain, 1.0);
+      const plan::Deviation d = plan::measure_deviation(goal_outcome(atoms, m, rng, p), design, kDomain, 1.0);
       EXPECT_TRUE(d.within_tolerance) << across << " across, p " << p << ": out " << d.worst_out << ", missing "
                                       << d.worst_missing;
     }
@@ -138,7 +138,7 @@ TEST(ThinParts, AGapIsKeptOpenByAnAtomACutterClearOfTheDesignRemoves) {
       EXPECT_TRUE(intersect(milled, atoms.atom_solid(int(a))).empty()) << "must-out atom " << a << " is left";
     }
   }
-  const Deviation d = measure_deviation(milled, design, kDomain, 1.0);
+  const plan::Deviation d = plan::measure_deviation(milled, design, kDomain, 1.0);
   EXPECT_TRUE(d.within_tolerance) << "out " << d.worst_out << ", missing " << d.worst_missing;
 }
 
@@ -172,7 +172,7 @@ TEST(ThinParts, EveryGoalOutcomeIsWithinToleranceBothWays) {
           const auto m = measure_atoms(*atoms, design, make_tolerance_zone(design, t), 0.0);
           if (has_violating(m)) continue;
           for (double p : {0.0, 0.3, 0.7, 1.0}) {
-            const Deviation d = measure_deviation(goal_outcome(*atoms, m, rng, p), design, kDomain, t);
+            const plan::Deviation d = plan::measure_deviation(goal_outcome(*atoms, m, rng, p), design, kDomain, t);
             ++checked;
             EXPECT_TRUE(d.within_tolerance) << h << " mm voxels, tolerance " << t << " mm, trial " << trial << ", p " << p
                                             << ": out " << d.worst_out << ", missing " << d.worst_missing;
@@ -198,7 +198,7 @@ TEST(ThinParts, SliversAreFreeAtAToleranceOfAVoxelAndUnderItOnlyWhereTheyHoldBot
   const auto loose = measure_atoms(atoms, design, make_tolerance_zone(design, 1.0), fin.volume() + 1);
   EXPECT_TRUE(loose[std::size_t(atoms.atom_at({10, 10, 15}))].sliver);
   EXPECT_EQ(loose[std::size_t(atoms.atom_at({10, 10, 15}))].atom_class, AtomClass::Free);
-  EXPECT_FALSE(measure_deviation(plate, design, kDomain, 1.0).within_tolerance);
+  EXPECT_FALSE(plan::measure_deviation(plate, design, kDomain, 1.0).within_tolerance);
   const auto strict = measure_atoms(atoms, design, make_tolerance_zone(design, 0.9), fin.volume() + 1);
   EXPECT_EQ(strict[std::size_t(atoms.atom_at({10, 10, 15}))].atom_class, AtomClass::MustIn);
   AtomDecomposition tall(kUnit, kDomain);

@@ -9,7 +9,7 @@
 
 #include "geometry/morphology.hpp"
 #include "geometry/shapes.hpp"
-#include "planner/deviation.hpp"
+#include "plan/deviation.hpp"
 
 namespace hybridctl::planner {
 namespace {
@@ -39,7 +39,7 @@ TEST(ToleranceZone, AThinFinHasNoCoreAndIsThin) {
     EXPECT_TRUE(subtract(z.thin, design).empty());
     // The core and hull alone let a plan make the plate without the fin: 12 voxels off.
     EXPECT_TRUE(subtract(z.core, plate()).empty());
-    EXPECT_DOUBLE_EQ(measure_deviation(plate(), design, kDomain, 1.0).worst_missing, 12.0);
+    EXPECT_DOUBLE_EQ(plan::measure_deviation(plate(), design, kDomain, 1.0).worst_missing, 12.0);
   }
 }
 

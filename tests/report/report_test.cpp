@@ -16,7 +16,7 @@
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
 #include "geometry/mesh.hpp"
-#include "planner/plan_file.hpp"
+#include "plan/plan_file.hpp"
 #include "planner/plan_report.hpp"
 #include "geometry/vdb_file.hpp"
 #include "report/report.hpp"
@@ -155,7 +155,7 @@ TEST(Report, FromThePlanInMemoryIsTheReportFromItsDirectory) {
   const fs::path dir = test_root() / "in-memory";
   const planner::ReportSources sources{"flanged-hub.stl", "hybrid-3axis.yaml", machine.name, text};
   planner::write_plan_directory(result, sources, dir);
-  const planner::PlanFile in_memory = planner::to_plan_file(result, sources, dir);
+  const plan::PlanFile in_memory = planner::to_plan_file(result, sources, dir);
 
   ReportRequest request;
   request.plan = dir;
@@ -192,7 +192,7 @@ TEST(Report, ListsEachOffendingAtomOfAPartTheMachineCannotMake) {
 
 TEST(Report, SplitsWhatARunBuiltAgainstTheDesignAtTheTolerance) {
   const fs::path dir = bracket();
-  const planner::PlanFile file = planner::read_plan_file(dir);
+  const plan::PlanFile file = plan::read_plan_file(dir);
   // A voxel layer too much on the wall's top and a block in the air (both beyond the 0.5 mm
   // tolerance: a 2 mm voxel is 1 mm from the surface, as measure_deviation counts it), and a
   // hole in the design.

@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "../validation/validation_cases.hpp"
-#include "planner/plan_file.hpp"
+#include "plan/plan_file.hpp"
 
 namespace hybridctl::report {
 namespace {
@@ -19,7 +19,7 @@ using validation::cases::machine;
 
 // A block from a raw stock with two overlapping steps milled from above, by the 10 mm flat
 // (P2) and the 3 mm flat (P3), in three plans: P2 then P3, P2 alone, P3 then P2.
-planner::PlanFile stepped_block() {
+plan::PlanFile stepped_block() {
   Case c(0.5);
   const Solid raw = c.box({{0, 0, 0}, {30, 20, 10}});
   const Solid step_a = c.box({{20, -5, 6}, {35, 25, 15}}), step_b = c.box({{-5, -5, 8}, {24, 25, 15}});
@@ -27,13 +27,13 @@ planner::PlanFile stepped_block() {
   const int s = c.stock(raw), a = c.mill(step_a, 1), b = c.mill(step_b, 3);
   c.file.plans = {c.plan({s, a, b}), c.plan({s, a}), c.plan({s, b, a})};
   for (std::size_t k = 0; k < c.file.plans.size(); ++k)
-    for (planner::PlanFileAction& action : c.file.plans[k].actions) action.cost = double(k + 1);
+    for (plan::PlanFileAction& action : c.file.plans[k].actions) action.cost = double(k + 1);
   return c.file;
 }
 
-std::vector<std::vector<Solid>> states_of(const planner::PlanFile& file) {
+std::vector<std::vector<Solid>> states_of(const plan::PlanFile& file) {
   std::vector<std::vector<Solid>> out;
-  for (const planner::PlanFilePlan& plan : file.plans) out.push_back(planner::plan_states(file, plan));
+  for (const plan::PlanFilePlan& plan : file.plans) out.push_back(plan::plan_states(file, plan));
   return out;
 }
 
@@ -48,11 +48,11 @@ void expect_same(const ActionPath& a, const ActionPath& b, const std::string& wh
 }
 
 TEST(ReportToolpaths, EachPlanIsAsIfExportedAloneThoughPlansShareTheirFirstActions) {
-  const planner::PlanFile file = stepped_block();
+  const plan::PlanFile file = stepped_block();
   const std::vector<PlanPaths> all = plan_paths(file, states_of(file), machine());
   ASSERT_EQ(all.size(), 3u);
   for (std::size_t k = 0; k < file.plans.size(); ++k) {
-    planner::PlanFile alone = file;
+    plan::PlanFile alone = file;
     alone.plans = {file.plans[k]};
     const std::vector<PlanPaths> one = plan_paths(alone, states_of(alone), machine());
     ASSERT_EQ(one.size(), 1u);
@@ -76,7 +76,7 @@ TEST(ReportToolpaths, EachPlanIsAsIfExportedAloneThoughPlansShareTheirFirstActio
 }
 
 TEST(ReportToolpaths, APlanTheMachineCannotMakeKeepsItsReasonAndTheOthersTheirPaths) {
-  planner::PlanFile file = stepped_block();
+  plan::PlanFile file = stepped_block();
   file.primitives[2].setup = "no-such-setup";
   const std::vector<PlanPaths> all = plan_paths(file, states_of(file), machine());
   ASSERT_EQ(all.size(), 3u);

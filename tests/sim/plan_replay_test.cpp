@@ -15,7 +15,7 @@
 #include "geometry/mesh.hpp"
 #include "geometry/morphology.hpp"
 #include "planner/plan_report.hpp"
-#include "planner/start_stock.hpp"
+#include "plan/start_stock.hpp"
 #include "sim/replay.hpp"
 
 namespace hybridctl::sim {
@@ -26,7 +26,7 @@ using geometry::Solid;
 
 struct Planned {
   config::Machine machine;
-  planner::PlanFile file;
+  plan::PlanFile file;
 };
 
 // Planned once for all tests, at 0.5 mm, and read back from its directory as
@@ -48,7 +48,7 @@ const Planned& planned() {
     const planner::PlanningResult r = planner::plan_part(mesh, "flanged-hub.stl", out.machine, options);
     const fs::path dir = fs::temp_directory_path() / ("hybridctl-replay-" + std::to_string(::getpid()));
     planner::write_plan_directory(r, {"flanged-hub.stl", "hybrid-3axis.yaml", out.machine.name, ""}, dir);
-    out.file = planner::read_plan_file(dir);
+    out.file = plan::read_plan_file(dir);
     fs::remove_all(dir);
     return out;
   }();
@@ -62,9 +62,9 @@ int first_rank(int tool, bool deposits) {
   for (std::size_t k = 0; k < p.file.plans.size(); ++k) {
     bool mills = false, deposited = false;
     for (const auto& a : p.file.plans[k].actions) {
-      const planner::PlanFilePrimitive& prim = p.file.primitives[std::size_t(a.primitive)];
-      mills = mills || (prim.mode == planner::Mode::Subtractive && (tool == 0 || prim.tool_number == tool));
-      deposited = deposited || (prim.mode == planner::Mode::Additive && !prim.raw_stock());
+      const plan::PlanFilePrimitive& prim = p.file.primitives[std::size_t(a.primitive)];
+      mills = mills || (prim.mode == config::Mode::Subtractive && (tool == 0 || prim.tool_number == tool));
+      deposited = deposited || (prim.mode == config::Mode::Additive && !prim.raw_stock());
     }
     if (mills && deposited == deposits) return int(k) + 1;
   }
@@ -79,7 +79,7 @@ struct ActionFigures {
 // Replays every action of plan `rank` and checks it; returns the figures per action.
 std::vector<ActionFigures> replay_plan(int rank) {
   const Planned& p = planned();
-  const planner::PlanFilePlan& plan = p.file.plans[std::size_t(rank - 1)];
+  const plan::PlanFilePlan& plan = p.file.plans[std::size_t(rank - 1)];
   const toolpaths::PlanExport exported = toolpaths::export_plan(p.file, plan, p.machine);
   const double h = p.file.lattice.voxel_size;
   std::vector<ActionFigures> out;
@@ -88,7 +88,7 @@ std::vector<ActionFigures> replay_plan(int rank) {
     const std::string text = gcode::write_action(a.program, p.machine);
     ReplayOptions options;
     options.protected_region =
-        planner::spared_by_cuts(p.file, &p.file.primitives.at(std::size_t(plan.actions.at(std::size_t(a.step - 1)).primitive)));
+        plan::spared_by_cuts(p.file, &p.file.primitives.at(std::size_t(plan.actions.at(std::size_t(a.step - 1)).primitive)));
     const ReplayResult r = replay_program(text, p.machine, a.before, options, a.primitive + ".ngc");
     ActionFigures f;
     f.roi = a.roi.volume();

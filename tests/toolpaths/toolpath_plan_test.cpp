@@ -42,8 +42,8 @@ TEST(ToolpathsForAPlan, FlangedHubOnTheHybridMachine) {
     bool mills = false, deposits = false;
     for (const auto& s : p.steps) {
       const auto& prim = r.primitives[std::size_t(s.primitive)];
-      mills = mills || prim.mode == planner::Mode::Subtractive;
-      deposits = deposits || (prim.mode == planner::Mode::Additive && prim.kind != planner::PrimitiveKind::RawStock);
+      mills = mills || prim.mode == config::Mode::Subtractive;
+      deposits = deposits || (prim.mode == config::Mode::Additive && prim.kind != config::PrimitiveKind::RawStock);
     }
     if (mills && deposits) {
       plan = &p;
@@ -58,12 +58,12 @@ TEST(ToolpathsForAPlan, FlangedHubOnTheHybridMachine) {
   for (const auto& step : plan->steps) {
     const planner::Primitive& prim = r.primitives[std::size_t(step.primitive)];
     SCOPED_TRACE(prim.label);
-    if (prim.kind == planner::PrimitiveKind::RawStock) {
+    if (prim.kind == config::PrimitiveKind::RawStock) {
       state = geometry::unite(state, prim.region);
       continue;
     }
     const config::Setup& setup = *machine.find_setup(prim.setup);
-    if (prim.mode == planner::Mode::Additive) {
+    if (prim.mode == config::Mode::Additive) {
       const config::AdditiveHead& head = *machine.find_head(prim.capability);
       const Solid roi = geometry::subtract(prim.region, state);
       const Toolpath p = deposition_path(roi, state, head, setup);

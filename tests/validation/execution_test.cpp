@@ -27,7 +27,7 @@ std::vector<std::string> kinds(const Execution& run) {
   return out;
 }
 
-const planner::RejectionReason* first_of(const Execution& run, const std::string& kind) {
+const plan::RejectionReason* first_of(const Execution& run, const std::string& kind) {
   for (const auto& r : run.reasons)
     if (r.kind == kind) return &r;
   return nullptr;
@@ -119,7 +119,7 @@ TEST(Execution, AThinFinLeftOutIsMissingMaterialAtItsTip) {
   const Solid plate = c.box({{5, 5, 0}, {25, 25, 4}});
   c.file.design = unite(plate, c.box({{14, 7, 4}, {15, 23, 12}}));  // 1 mm thick, 8 mm tall
   const Execution run = execute_plan(c.file, c.plan({c.deposit(plate)}), machine());
-  const planner::RejectionReason* r = first_of(run, "missing_material");
+  const plan::RejectionReason* r = first_of(run, "missing_material");
   ASSERT_NE(r, nullptr) << all_reasons(run);
   const auto at = r->message.find("lies up to ");
   ASSERT_NE(at, std::string::npos) << r->message;
@@ -163,14 +163,14 @@ TEST(Execution, TheCoreMissingAfterTheLastAdditionStopsTheRunThere) {
   Case c(1.0);
   const Solid pad = c.box({{20, 5, 0}, {30, 15, 2}}), floating = c.box({{5, 5, 6}, {15, 15, 9}});
   c.file.design = unite(pad, floating);
-  const planner::PlanFilePlan plan =
+  const plan::PlanFilePlan plan =
       c.plan({c.deposit(pad), c.deposit(floating), c.mill(c.box({{0, 0, 20}, {40, 30, 24}}), 1)});
   ExecutionOptions validating;
   validating.run_until = RunUntil::FirstFailingAction;
   const Execution stopped = execute_plan(c.file, plan, machine(), validating);
   EXPECT_EQ(stopped.stopped_after, 2) << all_reasons(stopped);
   EXPECT_TRUE(stopped.missing_after_last_addition);
-  const planner::RejectionReason* r = first_of(stopped, "missing_material");
+  const plan::RejectionReason* r = first_of(stopped, "missing_material");
   ASSERT_NE(r, nullptr) << all_reasons(stopped);
   EXPECT_EQ(r->action, 2);
   EXPECT_NE(r->message.find("the last that adds material"), std::string::npos) << r->message;
@@ -188,7 +188,7 @@ TEST(Execution, TheCoreMissingAfterTheLastAdditionStopsTheRunThere) {
   EXPECT_TRUE(has(whole, "missing_material")) << all_reasons(whole);
 
   // The same actions with the block deposited again at the end are not stopped early.
-  const planner::PlanFilePlan again = c.plan({0, 1, 2, 1});
+  const plan::PlanFilePlan again = c.plan({0, 1, 2, 1});
   const Execution later = execute_plan(c.file, again, machine(), validating);
   EXPECT_NE(later.stopped_after, 2) << all_reasons(later);
 }
@@ -235,7 +235,7 @@ TEST(Execution, ALayerUnderExistingMaterialIsSkippedAndRejected) {
   c.file.design = unite(table, under);
   const int s = c.stock(table);
   const Execution run = execute_plan(c.file, c.plan({s, c.deposit(under)}), machine());
-  const planner::RejectionReason* r = first_of(run, "layer_skipped");
+  const plan::RejectionReason* r = first_of(run, "layer_skipped");
   ASSERT_NE(r, nullptr) << all_reasons(run);
   EXPECT_EQ(r->action, 2);
   ASSERT_TRUE(r->where);
@@ -261,7 +261,7 @@ TEST(Execution, HeadTravelIsPlannedAgainstTheMaterialTheMillingReallyLeft) {
   ExecutionOptions planned;
   planned.planned_against = PlannedAgainst::PlannedState;
   const Execution blind = execute_plan(c.file, c.plan({s, m, d}), machine(), planned);
-  const planner::RejectionReason* rapid = first_of(blind, "rapid_into_material");
+  const plan::RejectionReason* rapid = first_of(blind, "rapid_into_material");
   ASSERT_NE(rapid, nullptr) << all_reasons(blind);
   EXPECT_EQ(rapid->action, 3);
   EXPECT_GT(rapid->line, 0);
@@ -300,11 +300,11 @@ TEST(Execution, TheLinesAreThoseOfTheWholePlansProgram) {
   const int s = c.stock(raw);
   const int m = c.mill(step, 1);
   const int d = c.deposit(strip);
-  const planner::PlanFilePlan plan = c.plan({s, m, d});
+  const plan::PlanFilePlan plan = c.plan({s, m, d});
   const Execution run = execute_plan(c.file, plan, machine());
   const gcode::PostedProgram whole = gcode::post_program(run.exported.programs(), machine());
   EXPECT_EQ(run.program.lines, whole.lines);
-  const planner::RejectionReason* r = first_of(run, "nozzle_collision");
+  const plan::RejectionReason* r = first_of(run, "nozzle_collision");
   if (!r) r = first_of(run, "body_collision");
   ASSERT_NE(r, nullptr) << all_reasons(run);
   EXPECT_EQ(r->action, 3);
@@ -330,11 +330,11 @@ TEST(Execution, TheSearchGoesOnToTheNextValidPlan) {
   c.mill(pocket, 3);
   using planner::testing::VoxelPrimitive;
   const planner::testing::VoxelProblem vp = planner::testing::make_problem(
-      {VoxelPrimitive{"P1", planner::Mode::Additive, true, 0.0, c.file.primitives[0].region},
-       VoxelPrimitive{"P2", planner::Mode::Subtractive, false, 0.2, c.file.primitives[1].region},
-       VoxelPrimitive{"P3", planner::Mode::Subtractive, false, 1.0, c.file.primitives[2].region}},
+      {VoxelPrimitive{"P1", config::Mode::Additive, true, 0.0, c.file.primitives[0].region},
+       VoxelPrimitive{"P2", config::Mode::Subtractive, false, 0.2, c.file.primitives[1].region},
+       VoxelPrimitive{"P3", config::Mode::Subtractive, false, 1.0, c.file.primitives[2].region}},
       c.file.design, c.file.domain, c.file.tolerance);
-  std::vector<std::vector<planner::RejectionReason>> rejected;
+  std::vector<std::vector<plan::RejectionReason>> rejected;
   planner::SearchOptions options;
   options.top_k = 1;
   options.accept = [&](const planner::Plan& plan) {
@@ -355,7 +355,7 @@ TEST(Execution, TheSearchGoesOnToTheNextValidPlan) {
   ASSERT_EQ(rejected.size(), 1u);
   const auto& reasons = rejected.front();
   EXPECT_TRUE(std::any_of(reasons.begin(), reasons.end(),
-                          [](const planner::RejectionReason& r) { return r.kind == "unreachable" && r.action == 2; }))
+                          [](const plan::RejectionReason& r) { return r.kind == "unreachable" && r.action == 2; }))
       << describe_reasons(reasons);
 }
 

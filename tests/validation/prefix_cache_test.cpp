@@ -25,7 +25,7 @@ using geometry::Solid;
 struct SharedPrefixes {
   Case c{1.0};
   int s, m, m3, wall_strip, free_strip, slot;
-  std::vector<planner::PlanFilePlan> plans;
+  std::vector<plan::PlanFilePlan> plans;
 
   SharedPrefixes() {
     const Solid raw = c.box({{0, 0, 0}, {30, 20, 25}}), step = c.box({{15, -5, 5}, {35, 25, 30}});
@@ -56,7 +56,7 @@ void expect_same(const Execution& cached, const Execution& scratch, const std::s
   ASSERT_EQ(cached.reasons.size(), scratch.reasons.size()) << describe_reasons(cached.reasons) << "\nvs\n"
                                                            << describe_reasons(scratch.reasons);
   for (std::size_t i = 0; i < scratch.reasons.size(); ++i) {
-    const planner::RejectionReason &a = cached.reasons[i], &b = scratch.reasons[i];
+    const plan::RejectionReason &a = cached.reasons[i], &b = scratch.reasons[i];
     EXPECT_EQ(a.kind, b.kind);
     EXPECT_EQ(a.action, b.action);
     EXPECT_EQ(a.line, b.line);
@@ -99,14 +99,14 @@ void expect_same(const Execution& cached, const Execution& scratch, const std::s
   }
 }
 
-std::string name_of(const planner::PlanFilePlan& plan) {
+std::string name_of(const plan::PlanFilePlan& plan) {
   std::string out;
-  for (const planner::PlanFileAction& a : plan.actions) out += "P" + std::to_string(a.primitive + 1) + " ";
+  for (const plan::PlanFileAction& a : plan.actions) out += "P" + std::to_string(a.primitive + 1) + " ";
   return out;
 }
 
 void run_all(const SharedPrefixes& t, const ExecutionOptions& options, PrefixCache& cache) {
-  for (const planner::PlanFilePlan& plan : t.plans) {
+  for (const plan::PlanFilePlan& plan : t.plans) {
     const Execution scratch = execute_plan(t.c.file, plan, machine(), options);
     const Execution cached = execute_plan(t.c.file, plan, machine(), options, &cache);
     expect_same(cached, scratch, name_of(plan));
@@ -120,7 +120,7 @@ TEST(PrefixCache, ThePlansFailInDifferentWays) {
   options.run_until = RunUntil::FirstFailingAction;
   std::set<std::string> kinds;
   std::set<int> stops;
-  for (const planner::PlanFilePlan& plan : t.plans) {
+  for (const plan::PlanFilePlan& plan : t.plans) {
     const Execution run = execute_plan(t.c.file, plan, machine(), options);
     for (const auto& r : run.reasons) kinds.insert(r.kind);
     stops.insert(run.stopped_after);

@@ -6,7 +6,7 @@
 
 #include "config/machine_loader.hpp"
 #include "geometry/shapes.hpp"
-#include "planner/plan_file.hpp"
+#include "plan/plan_file.hpp"
 
 namespace hybridctl::validation::cases {
 
@@ -20,7 +20,7 @@ inline const config::Machine& machine() {
 
 // A plan file built by hand: 0.5 mm voxels over 40 x 30 x 24 mm from the origin.
 struct Case {
-  planner::PlanFile file;
+  plan::PlanFile file;
 
   explicit Case(double tolerance) {
     file.machine_name = machine().name;
@@ -30,12 +30,12 @@ struct Case {
     file.design = Solid(file.lattice, file.domain);
   }
   Solid box(Box3 b) const { return geometry::make_box(file.lattice, b); }
-  int add(const std::string& kind, planner::Mode mode, const std::string& capability, const std::string& setup,
+  int add(const std::string& kind, config::Mode mode, const std::string& capability, const std::string& setup,
           const Solid& region, int tool_number = 0) {
-    planner::PlanFilePrimitive p;
+    plan::PlanFilePrimitive p;
     p.name = "P" + std::to_string(file.primitives.size() + 1);
     p.label = kind + " " + capability;
-    p.kind = kind;
+    p.kind = *config::primitive_kind_named(kind);
     p.mode = mode;
     p.capability = capability;
     p.setup = setup;
@@ -44,15 +44,15 @@ struct Case {
     file.primitives.push_back(std::move(p));
     return int(file.primitives.size()) - 1;
   }
-  int stock(const Solid& region) { return add("raw-stock", planner::Mode::Additive, "block", "", region); }
+  int stock(const Solid& region) { return add("raw-stock", config::Mode::Additive, "block", "", region); }
   int deposit(const Solid& region, const std::string& setup = "top") {
-    return add("u-am", planner::Mode::Additive, "ded", setup, region);
+    return add("u-am", config::Mode::Additive, "ded", setup, region);
   }
   int mill(const Solid& region, int tool, const std::string& setup = "top") {
-    return add("sm-cons", planner::Mode::Subtractive, "T" + std::to_string(tool), setup, region, tool);
+    return add("sm-cons", config::Mode::Subtractive, "T" + std::to_string(tool), setup, region, tool);
   }
-  planner::PlanFilePlan plan(std::vector<int> actions) const {
-    planner::PlanFilePlan p;
+  plan::PlanFilePlan plan(std::vector<int> actions) const {
+    plan::PlanFilePlan p;
     for (int a : actions) p.actions.push_back({a, 0, 0});
     return p;
   }

@@ -8,9 +8,9 @@
 #include <string_view>
 
 #include "config/machine.hpp"
-#include "planner/plan_file.hpp"
+#include "plan/plan_file.hpp"
 
-namespace hybridctl::planner {
+namespace hybridctl::plan {
 
 // FNV-1a 64 of a machine file's text, as 16 lower-case hex digits (plan.json's machine.hash).
 std::string machine_text_hash(std::string_view yaml_text);
@@ -32,4 +32,4 @@ struct PlanMachine {
 // config::MachineFileError for a machine text with problems.
 PlanMachine plan_machine(const PlanFile& file, const MachineChoice& choice);
 
-}  // namespace hybridctl::planner
+}  // namespace hybridctl::plan

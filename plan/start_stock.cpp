@@ -1,11 +1,11 @@
-#include "planner/start_stock.hpp"
+#include "plan/start_stock.hpp"
 
 #include <algorithm>
 
 #include "common/error.hpp"
 #include "geometry/morphology.hpp"
 
-namespace hybridctl::planner {
+namespace hybridctl::plan {
 
 geometry::IndexBox simulated_domain(const PlanFile& file, const PlanFilePlan& plan, const config::Machine& machine) {
   geometry::IndexBox box = file.domain;
@@ -48,4 +48,4 @@ geometry::Solid spared_by_cuts(const PlanFile& file, const PlanFilePrimitive* ac
   return geometry::erode(kept, geometry::Ball{file.tolerance});
 }
 
-}  // namespace hybridctl::planner
+}  // namespace hybridctl::plan

@@ -10,7 +10,7 @@
 
 #include "geometry/solid.hpp"
 
-namespace hybridctl::planner {
+namespace hybridctl::plan {
 
 // One located reason. `kind` is one of the names in docs/plan-format.md ("gouge",
 // "rapid_into_material", "missing_material", "layer_skipped", ...).
@@ -26,4 +26,4 @@ struct RejectionReason {
 // "action 2, line 6112: rapid into material: ... at (x, y, z) mm".
 std::string describe(const RejectionReason& reason);
 
-}  // namespace hybridctl::planner
+}  // namespace hybridctl::plan

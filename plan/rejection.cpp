@@ -1,8 +1,8 @@
-#include "planner/rejection.hpp"
+#include "plan/rejection.hpp"
 
 #include "common/number_text.hpp"
 
-namespace hybridctl::planner {
+namespace hybridctl::plan {
 
 std::string describe(const RejectionReason& r) {
   std::string out;
@@ -16,4 +16,4 @@ std::string describe(const RejectionReason& r) {
   return out;
 }
 
-}  // namespace hybridctl::planner
+}  // namespace hybridctl::plan

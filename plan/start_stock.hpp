@@ -5,9 +5,9 @@
 
 #include "config/machine.hpp"
 #include "geometry/solid.hpp"
-#include "planner/plan_file.hpp"
+#include "plan/plan_file.hpp"
 
-namespace hybridctl::planner {
+namespace hybridctl::plan {
 
 // On the plan's lattice, stored over the box the simulated machine works in. A plan that
 // starts from a raw stock: that stock, over the plan's domain (deposit beyond the stock's
@@ -31,4 +31,4 @@ geometry::IndexBox simulated_domain(const PlanFile& file, const PlanFilePlan& pl
 // `action`, or for an additive one, the whole design shrunk by the tolerance.
 geometry::Solid spared_by_cuts(const PlanFile& file, const PlanFilePrimitive* action = nullptr);
 
-}  // namespace hybridctl::planner
+}  // namespace hybridctl::plan

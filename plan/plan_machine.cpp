@@ -1,12 +1,12 @@
-#include "planner/plan_machine.hpp"
+#include "plan/plan_machine.hpp"
 
 #include <filesystem>
 
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
-#include "protocol/checksums.hpp"
+#include "common/hash.hpp"
 
-namespace hybridctl::planner {
+namespace hybridctl::plan {
 namespace {
 
 namespace fs = std::filesystem;
@@ -66,7 +66,7 @@ PlanMachine named_machine(const PlanFile& file) {
 
 }  // namespace
 
-std::string machine_text_hash(std::string_view yaml_text) { return hex16(protocol::fnv1a64(yaml_text)); }
+std::string machine_text_hash(std::string_view yaml_text) { return hex16(fnv1a64(yaml_text)); }
 
 PlanMachine plan_machine(const PlanFile& file, const MachineChoice& choice) {
   if (!choice.file.empty()) return given_machine(file, choice);
@@ -77,4 +77,4 @@ PlanMachine plan_machine(const PlanFile& file, const MachineChoice& choice) {
   return m;
 }
 
-}  // namespace hybridctl::planner
+}  // namespace hybridctl::plan

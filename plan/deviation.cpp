@@ -1,4 +1,4 @@
-#include "planner/deviation.hpp"
+#include "plan/deviation.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include "common/number_text.hpp"
 #include "geometry/distance_field.hpp"
 
-namespace hybridctl::planner {
+namespace hybridctl::plan {
 namespace {
 
 using geometry::FarthestVoxel;
@@ -73,4 +73,4 @@ std::string deviation_text(const Deviation& d, double tolerance) {
          (d.within_tolerance ? "within" : "OUTSIDE") + " tolerance (" + shortest_number(tolerance) + " mm)";
 }
 
-}  // namespace hybridctl::planner
+}  // namespace hybridctl::plan

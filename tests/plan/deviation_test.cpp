@@ -1,8 +1,8 @@
-// planner::measure_deviation: the one measure of how far a made solid is from the design,
+// plan::measure_deviation: the one measure of how far a made solid is from the design,
 // both ways (plan.json's deviation, dry-run's "vs design" line). Known distances on
 // simple voxel shapes, and the half-voxel convention.
 
-#include "planner/deviation.hpp"
+#include "plan/deviation.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 
 #include "geometry/shapes.hpp"
 
-namespace hybridctl::planner {
+namespace hybridctl::plan {
 namespace {
 
 using geometry::make_box;
@@ -145,4 +145,4 @@ TEST(Deviation, TextSaysWithinOnlyWhenBothDirectionsHold) {
 }
 
 }  // namespace
-}  // namespace hybridctl::planner
+}  // namespace hybridctl::plan

@@ -27,7 +27,7 @@
 
 #include "geometry/solid.hpp"
 
-namespace hybridctl::planner {
+namespace hybridctl::plan {
 
 struct Deviation {
   double over_volume = 0;     // mm^3 of material outside the design
@@ -52,4 +52,4 @@ Deviation measure_deviation(const geometry::Solid& made, const geometry::Solid& 
 // both hold.
 std::string deviation_text(const Deviation& d, double tolerance);
 
-}  // namespace hybridctl::planner
+}  // namespace hybridctl::plan

@@ -9,22 +9,28 @@
 #include <string_view>
 #include <vector>
 
+#include "config/primitive_kind.hpp"
 #include "geometry/solid.hpp"
-#include "planner/rejection.hpp"
-#include "planner/search.hpp"
+#include "plan/rejection.hpp"
 
-namespace hybridctl::planner {
+namespace hybridctl::plan {
+
+using config::Mode;
+using config::PrimitiveKind;
+
+// plan.json's `version`: what this reader reads and the writer writes.
+inline constexpr int kPlanFormatVersion = 1;
 
 struct PlanFilePrimitive {
   std::string name;        // P1, P2, ...
   std::string label;
-  std::string kind;        // raw-stock, u-am, o-am, sm-max, sm-cons, file
+  PrimitiveKind kind = PrimitiveKind::File;
   Mode mode = Mode::Additive;
   std::string capability;  // head name, T<n>, stock name or file path
   std::string setup;       // empty for stocks and files
   int tool_number = 0;     // cutting tools
   geometry::Solid region;
-  bool raw_stock() const { return kind == "raw-stock"; }
+  bool raw_stock() const { return kind == PrimitiveKind::RawStock; }
   friend bool operator==(const PlanFilePrimitive&, const PlanFilePrimitive&) = default;
 };
 
@@ -70,8 +76,6 @@ struct PlanFile {
   friend bool operator==(const PlanFile&, const PlanFile&) = default;
 };
 
-struct PlanningResult;
-struct ReportSources;
 
 // Reads DIR/plan.json (or the plan.json given) and the .vdb files it names. Throws
 // hybridctl::InputError naming the file and the JSON location of anything missing,
@@ -91,14 +95,16 @@ struct PlanGrid {
 };
 PlanGrid read_plan_grid(const std::filesystem::path& plan_json_or_directory);
 
-// The planning result as write_plan_directory(result, sources, directory) writes it and
-// read_plan_file(directory) reads it back, without the files: equal to what is read back,
-// down to where each solid stores its voxels.
-PlanFile to_plan_file(const PlanningResult& result, const ReportSources& sources,
-                      const std::filesystem::path& directory);
+// `path` (absolute, or relative to the working directory) as plan.json in `directory`
+// records it: relative to that directory, or absolute when no relative path leads there.
+std::string path_from_plan_directory(const std::string& path, const std::filesystem::path& directory);
+
+// A solid in memory as its .vdb reads back, on the plan's grid: a .vdb holds the voxels
+// only, so the storage is what their bounding box needs, clipped to the domain.
+geometry::Solid as_read_back(const geometry::Solid& s, const geometry::Lattice& lattice, const geometry::IndexBox& domain);
 
 // The states a plan passes through on the voxels: states[0] is empty, states[k] the
 // material after action k (AM unites, SM subtracts), clipped to the domain.
 std::vector<geometry::Solid> plan_states(const PlanFile& file, const PlanFilePlan& plan);
 
-}  // namespace hybridctl::planner
+}  // namespace hybridctl::plan

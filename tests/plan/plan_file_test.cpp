@@ -1,8 +1,8 @@
-// Reading plan.json back (planner/plan_file.hpp): a plan directory written here, read from
+// Reading plan.json back (plan/plan_file.hpp): a plan directory written here, read from
 // the file and from text alike, and bad JSON refused as InputError naming the file, never
 // any other exception (the fuzz target fuzz/plan_fuzz.cpp feeds the text form).
 
-#include "planner/plan_file.hpp"
+#include "plan/plan_file.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -14,7 +14,7 @@
 #include "common/error.hpp"
 #include "geometry/vdb_file.hpp"
 
-namespace hybridctl::planner {
+namespace hybridctl::plan {
 namespace {
 
 namespace fs = std::filesystem;
@@ -93,4 +93,4 @@ TEST_F(PlanFileTest, WrongValuesNameTheirJsonLocation) {
 }
 
 }  // namespace
-}  // namespace hybridctl::planner
+}  // namespace hybridctl::plan

@@ -1,4 +1,4 @@
-#include "planner/plan_file.hpp"
+#include "plan/plan_file.hpp"
 
 #include <cmath>
 #include <fstream>
@@ -7,10 +7,9 @@
 
 #include "common/error.hpp"
 #include "geometry/vdb_file.hpp"
-#include "planner/plan_machine.hpp"
-#include "planner/plan_report.hpp"
+#include "plan/plan_machine.hpp"
 
-namespace hybridctl::planner {
+namespace hybridctl::plan {
 namespace {
 
 namespace fs = std::filesystem;
@@ -97,12 +96,6 @@ geometry::Solid load_region(const fs::path& directory, const Node& file_node, co
     throw InputError(path.string() + ": voxel size " + std::to_string(s.voxel_size()) + " mm; expected the plan's grid (" +
                      std::to_string(h) + " mm)");
   return on_plan_grid(s, lattice, domain);
-}
-
-// A solid in memory as its .vdb reads back: a .vdb holds the voxels only, so the storage
-// is what their bounding box needs.
-geometry::Solid as_read_back(const geometry::Solid& s, const geometry::Lattice& lattice, const geometry::IndexBox& domain) {
-  return on_plan_grid(intersect(s, geometry::Solid::filled(s.lattice(), s.bounding_box())), lattice, domain);
 }
 
 // The machine: embedded (`yaml` and its `hash`) since plans carry it; older plans name
@@ -230,7 +223,9 @@ PlanFile parse_plan_file(std::string_view json_text, const fs::path& json_path) 
     PlanFilePrimitive q;
     q.name = p.at("name").str();
     q.label = p.at("label").str();
-    q.kind = p.at("kind").str();
+    const std::optional<PrimitiveKind> kind = config::primitive_kind_named(p.at("kind").str());
+    if (!kind) p.at("kind").fail("one of \"raw-stock\", \"u-am\", \"o-am\", \"sm-max\", \"sm-cons\", \"file\"");
+    q.kind = *kind;
     const std::string mode = p.at("mode").str();
     if (mode != "additive" && mode != "subtractive") p.at("mode").fail("\"additive\" or \"subtractive\"");
     q.mode = mode == "additive" ? Mode::Additive : Mode::Subtractive;
@@ -265,34 +260,15 @@ PlanFile parse_plan_file(std::string_view json_text, const fs::path& json_path) 
   return f;
 }
 
-PlanFile to_plan_file(const PlanningResult& r, const ReportSources& sources, const fs::path& directory) {
-  PlanFile f;
-  f.directory = directory;
-  f.part = path_from_plan_directory(sources.part_path, directory);
-  f.machine_name = sources.machine_name;
-  f.machine_file = path_from_plan_directory(sources.machine_path, directory);
-  f.machine_yaml = sources.machine_text;
-  f.machine_hash = machine_text_hash(sources.machine_text);
-  f.lattice = r.lattice;
-  f.domain = r.domain;
-  f.tolerance = r.tolerance;
-  f.design = as_read_back(r.design, f.lattice, f.domain);
-  for (const Primitive& p : r.primitives) {
-    f.primitives.push_back({p.name, p.label, std::string(to_string(p.kind)), p.mode, primitive_capability(p, directory), p.setup,
-                            p.tool_number, as_read_back(p.region, f.lattice, f.domain)});
-  }
-  for (std::size_t k = 0; k < r.plans.size(); ++k) {
-    const Plan& plan = r.plans[k];
-    PlanFilePlan out{int(k + 1), expression(r.problem, plan), plan.cost, {}};
-    for (const PlanStep& step : plan.steps) out.actions.push_back({step.primitive, step.volume, step.cost});
-    f.plans.push_back(std::move(out));
-  }
-  for (const RejectedPlan& rejected : r.rejected) {
-    PlanFileRejected out{expression(r.problem, rejected.plan), rejected.plan.cost, {}, rejected.reasons};
-    for (const PlanStep& step : rejected.plan.steps) out.actions.push_back({step.primitive, step.volume, step.cost});
-    f.rejected.push_back(std::move(out));
-  }
-  return f;
+geometry::Solid as_read_back(const geometry::Solid& s, const geometry::Lattice& lattice, const geometry::IndexBox& domain) {
+  return on_plan_grid(intersect(s, geometry::Solid::filled(s.lattice(), s.bounding_box())), lattice, domain);
+}
+
+std::string path_from_plan_directory(const std::string& path, const std::filesystem::path& directory) {
+  if (path.empty()) return path;
+  const fs::path absolute = fs::absolute(path).lexically_normal();
+  const fs::path relative = absolute.lexically_relative(fs::absolute(directory).lexically_normal());
+  return relative.empty() ? absolute.generic_string() : relative.generic_string();
 }
 
 std::vector<geometry::Solid> plan_states(const PlanFile& file, const PlanFilePlan& plan) {
@@ -305,4 +281,4 @@ std::vector<geometry::Solid> plan_states(const PlanFile& file, const PlanFilePla
   return states;
 }
 
-}  // namespace hybridctl::planner
+}  // namespace hybridctl::plan
