@@ -29,6 +29,7 @@
 #include "geometry/vdb_file.hpp"
 #include "plan/plan_file.hpp"
 #include "plan/deviation.hpp"
+#include "planner/candidate_execution.hpp"
 #include "planner/plan_report.hpp"
 #include "validation/plan_validator.hpp"
 
@@ -207,7 +208,7 @@ int run_dry_run(const DryRunArgs& a) {
   options.tolerance = a.tolerance;
   options.max_uses = a.reuse;
   options.memory_budget = memory_budget(a.memory_budget);
-  validation::use_validation(options, machine);
+  planner::validate_by_execution(options, validation::plan_validator(machine), machine.name);
   options.stock_files = a.stock_files;
   options.objective = objective(a.objective);
   const planner::PlanningResult planned = planner::plan_part(geometry::read_stl(a.part), a.part, machine, options);

@@ -11,6 +11,7 @@
 #include "cli/report_job.hpp"
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
+#include "planner/candidate_execution.hpp"
 #include "planner/plan_report.hpp"
 #include "validation/plan_validator.hpp"
 
@@ -65,7 +66,7 @@ int run_plan(const PlanArgs& args) {
   for (const std::string& p : args.primitive_files) options.extra_primitives.push_back(parse_primitive_argument(p));
   options.stock_files = args.stock_files;
   // Every plan offered is proven by execution first (validation/, docs/validation.md).
-  if (!args.no_validate) validation::use_validation(options, machine);
+  if (!args.no_validate) planner::validate_by_execution(options, validation::plan_validator(machine), machine.name);
   options.bands = !args.no_bands;
   options.fine_graining = !args.no_fine_graining;
   options.filled = !args.no_filled;

@@ -212,7 +212,7 @@ class IncrementalRun {
   // (the raw stock counts) has run: throws Stopped when part of the design's core is missing, as
   // the actions after it only remove. Every voxel of the core lies farther than the
   // tolerance from the design's other side, so the part would be out of tolerance
-  // (planner/deviation.hpp, worst_out); stopping here spares running the removals.
+  // (plan/deviation.hpp, worst_out); stopping here spares running the removals.
   void check_core_after(int step) {
     if (options_.run_until != RunUntil::FirstFailingAction || core_checked_ || step < last_addition()) return;
     core_checked_ = true;
@@ -321,7 +321,7 @@ class IncrementalRun {
   }
 
   // Each action's lines spare what that action keeps of the design, not the whole design:
-  // a removal may cut design material a later deposit builds again (planner/start_stock.hpp).
+  // a removal may cut design material a later deposit builds again (plan/start_stock.hpp).
   void protect_for(const gcode::ProgramAction* action) {
     if (!action || action->number == protecting_) return;
     protecting_ = action->number;

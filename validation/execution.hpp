@@ -10,8 +10,9 @@
 //   const validation::Execution run = validation::execute_plan(file, file.plans[0], machine);
 //   if (!run.proven()) for (const auto& r : run.reasons) ... plan::describe(r) ...
 //
-// This library sits above the planner, toolpaths and sim (docs/architecture.md): the
-// planner offers it candidates through PlanningOptions::validate (validation/plan_validator.hpp).
+// This library sits above toolpaths and sim and knows plans only as plan files
+// (docs/architecture.md); the planner offers it candidates through a plan::CandidateExecutor
+// (validation/plan_validator.hpp, planner/candidate_execution.hpp).
 
 #include <string>
 #include <vector>

@@ -7,7 +7,7 @@
 // with it needs to go on, and it ends exactly as it would from the raw stock.
 //
 //   auto cache = std::make_shared<validation::PrefixCache>();
-//   options.validate = validation::plan_validator(machine, {}, cache);
+//   planner::validate_by_execution(options, validation::plan_validator(machine, {}, cache), machine.name);
 //   ... cache->stats().hits ...
 //
 // One cache serves one plan file, one machine and one set of ExecutionOptions (a plan

@@ -71,7 +71,7 @@ void add_incidents(const Execution& run, const config::Machine& machine, std::ve
 void add_deviation(const Execution& run, double tolerance, std::vector<RejectionReason>& out) {
   const plan::Deviation& d = run.deviation;
   if (d.within_tolerance) return;
-  // The two-sided test that decides `within_tolerance` (planner/deviation.hpp) names the
+  // The two-sided test that decides `within_tolerance` (plan/deviation.hpp) names the
   // reasons: a fin left out leaves few voxels empty, none deep, yet the design's surface at
   // its tip is far from the part made.
   if (d.worst_missing > tolerance)
