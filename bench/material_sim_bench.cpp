@@ -84,7 +84,7 @@ BENCHMARK(BM_FlatFullCircle);
 
 void BM_BeadMoves(benchmark::State& state) {
   const double h = state.range(0) / 100.0;
-  const sim::Bead bead{config::BeadShape::Ellipsoid, 3, 1.5, {}};
+  const sim::Bead bead{config::BeadShape::Ellipsoid, 3, 1.5, {}, {}};  // no nozzle body, no overhang
   const geometry::Lattice l{h, {0, 0, 0}};
   sim::MaterialSimulation s(geometry::Solid(l, {{0, 0, 0}, {int(200 / h), int(200 / h), int(50 / h)}}));
   std::int64_t i = 0;

@@ -105,6 +105,15 @@ planner::PlanningProblem synthetic_problem(int n, std::uint32_t seed) {
   return p;
 }
 
+// Search options with the top k and the expansion limit set, everything else at its
+// default (planner/search.hpp).
+planner::SearchOptions limits(int top_k, std::int64_t max_expansions) {
+  planner::SearchOptions options;
+  options.top_k = top_k;
+  options.max_expansions = max_expansions;
+  return options;
+}
+
 // Random instances vary a lot in difficulty: three seeds per size. The baseline stops at
 // the expansion limit of arg 2 (counter "limit" = 1 then) so the run always ends.
 void BM_AStar(benchmark::State& state) {
@@ -113,7 +122,7 @@ void BM_AStar(benchmark::State& state) {
   std::size_t found = 0;
   double cost = 0;
   for (auto _ : state) {
-    const auto plans = planner::baseline::find_plans(p, {1, state.range(2)}, &stats);
+    const auto plans = planner::baseline::find_plans(p, limits(1, state.range(2)), &stats);
     found = plans.size();
     cost = plans.empty() ? 0 : plans.front().cost;
   }
@@ -129,7 +138,7 @@ void BM_AStar(benchmark::State& state) {
 // and "groups": the primitives and atoms the search runs on (planner/search_reduce.hpp).
 void BM_Search(benchmark::State& state) {
   const auto p = synthetic_problem(int(state.range(0)), std::uint32_t(state.range(1)));
-  planner::SearchOptions options{int(state.range(2)), state.range(3)};
+  planner::SearchOptions options = limits(int(state.range(2)), state.range(3));
   options.block_orders = planner::BlockOrders::Cheapest;
   planner::SearchStats stats;
   std::vector<planner::Plan> plans;
@@ -158,7 +167,7 @@ void BM_SearchMachine(benchmark::State& state) {
                                              "-b-axis-0.5.problem.json");
   // As `plan` runs it: 10,000 expansions per search (arg 1 = 0), or with a 10 s budget
   // and no expansion limit (arg 1 = 2).
-  planner::SearchOptions options{3, state.range(1) == 2 ? 5'000'000 : 10'000};
+  planner::SearchOptions options = limits(3, state.range(1) == 2 ? 5'000'000 : 10'000);
   options.block_orders = planner::BlockOrders::Cheapest;
   if (state.range(1) == 2) options.time_limit = 10;
   if (state.range(2) == 1) options.direction = planner::SearchDirection::Backward;
@@ -166,7 +175,7 @@ void BM_SearchMachine(benchmark::State& state) {
   std::vector<planner::Plan> plans;
   for (auto _ : state) {
     if (state.range(1) == 1) {
-      plans = planner::baseline::find_plans(p, {3, 300'000}, &stats);
+      plans = planner::baseline::find_plans(p, limits(3, 300'000), &stats);
     } else {
       plans = planner::find_plans(p, options, &stats);
     }

@@ -65,21 +65,86 @@ std::optional<ProgramAction> parse_heading(std::string_view body) {
   return a;
 }
 
+/// One UTF-8 encoded character: its code point, 0 when the bytes are not valid UTF-8, and
+/// how many bytes it takes. An invalid sequence takes its lead byte and the continuation
+/// bytes that follow it before it breaks off, so it reads as one character.
+struct Utf8Character {
+  char32_t code_point = 0;
+  std::size_t length = 1;
+};
+
+Utf8Character decode_utf8(std::string_view s, std::size_t at) {
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
+  const unsigned char lead = byte(at);
+  std::size_t length = 0;
+  char32_t code_point = 0;
+  if (lead >= 0xC2 && lead <= 0xDF) {
+    length = 2;
+    code_point = lead & 0x1F;
+  } else if (lead >= 0xE0 && lead <= 0xEF) {
+    length = 3;
+    code_point = lead & 0x0F;
+  } else if (lead >= 0xF0 && lead <= 0xF4) {
+    length = 4;
+    code_point = lead & 0x07;
+  } else {
+    return {};
+  }
+  for (std::size_t k = 1; k < length; ++k) {
+    if (at + k >= s.size() || (byte(at + k) & 0xC0) != 0x80) return {0, k};
+    code_point = (code_point << 6) | (byte(at + k) & 0x3F);
+  }
+  constexpr char32_t kShortest[] = {0, 0, 0x80, 0x800, 0x10000};  // below: an overlong encoding
+  if (code_point < kShortest[length]) return {0, length};
+  return {code_point, length};
+}
+
+/// How a comment spells a character outside ASCII: the plan's set operators as the
+/// arithmetic they stand for, units as people type them, anything else '?'.
+std::string_view ascii_spelling(char32_t c) {
+  switch (c) {
+    case U'\u222A': return "+";  // ∪: a deposit joins the state
+    case U'\u2212': return "-";  // −: a cut takes from it
+    case U'\u2013': return "-";  // en dash
+    case U'\u2014': return "-";  // em dash
+    case U'\u00B2': return "2";  // mm²
+    case U'\u00B3': return "3";  // mm³
+    case U'\u00B0': return " deg";
+    case U'\u00D7': return "x";
+    case U'\u00F8': return "dia ";  // ø, a diameter
+    case U'\u00B5': return "u";     // µ (micro sign)
+    case U'\u03BC': return "u";     // μ (Greek mu)
+    case U'\u00B1': return "+/-";
+    case U'\u2264': return "<=";
+    case U'\u2265': return ">=";
+    case U'\u2192': return "->";
+    default: return "?";
+  }
+}
+
 }  // namespace
 
 std::string comment_text(std::string_view s) {
   std::string out;
   out.reserve(s.size());
-  for (char c : s) {
+  for (std::size_t i = 0; i < s.size();) {
+    char c = s[i];
+    if (static_cast<unsigned char>(c) >= 0x80) {
+      const Utf8Character u = decode_utf8(s, i);
+      out += ascii_spelling(u.code_point);
+      i += u.length;
+      continue;
+    }
     if (c == '(')
       c = '[';
     else if (c == ')')
       c = ']';
     else if (c == '\n' || c == '\r' || c == '\t')
       c = ' ';
-    else if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f)
+    else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
       c = '?';
     out += c;
+    ++i;
   }
   return out;
 }

@@ -73,8 +73,13 @@ struct PostedProgram {
   static PostedProgram from_text(std::string_view text);
 };
 
-/// Text that a comment can hold: '(' and ')' become '[' and ']', line breaks and tabs
-/// spaces, other control and non-ASCII bytes '?'.
+/// Text that a comment can hold, in plain ASCII in every dialect (the one place comment
+/// text is made): '(' and ')' become '[' and ']', line breaks and tabs spaces, other
+/// control bytes '?'. A UTF-8 character outside ASCII is spelled out where there is a
+/// readable spelling ("∪" "+", "−" "-", "³" "3", "²" "2", "°" " deg", "ø" "dia ", "×" "x",
+/// dashes "-", "µ" "u", "±" "+/-", "≤" "<=", "≥" ">=", "→" "->") and is one '?' otherwise,
+/// as is each broken UTF-8 sequence. So the plan "((P1 ∪ P9) − P7)" reads
+/// "[[P1 + P9] - P7]" in a comment.
 std::string comment_text(std::string_view text);
 
 }  // namespace hybridctl::gcode

@@ -60,7 +60,7 @@ TEST(LinuxcncConfig, AxesHaveTheMachinesTravel) {
       {"X", &machine().envelope.x}, {"Y", &machine().envelope.y}, {"Z", &machine().envelope.z}};
   int joint = 0;
   for (const auto& [name, axis] : axes) {
-    for (const std::string section : {"[AXIS_" + name + "]", "[JOINT_" + std::to_string(joint++) + "]"}) {
+    for (const std::string& section : {"[AXIS_" + name + "]", "[JOINT_" + std::to_string(joint++) + "]"}) {
       EXPECT_DOUBLE_EQ(std::stod(ini.at(section + "MIN_LIMIT")), axis->travel.min) << section;
       EXPECT_DOUBLE_EQ(std::stod(ini.at(section + "MAX_LIMIT")), axis->travel.max) << section;
     }

@@ -18,6 +18,7 @@
 
 #include "config/machine_loader.hpp"
 #include "gcode/interpreter.hpp"
+#include "gcode/program.hpp"
 #include "gcode/tool_table.hpp"
 #include "sample_programs.hpp"
 
@@ -310,6 +311,46 @@ TEST(PostActions, OneActionIsAStandaloneProgram) {
   const std::string wet = write_action(actions[1], m, coolant);
   EXPECT_NE(wet.find("\nS8000 M3\nM8\n"), std::string::npos) << wet;
   EXPECT_NE(wet.find("\nM9\n"), std::string::npos) << wet;
+}
+
+// Comments carry plan expressions ("∪", "−") and units ("mm³", "°") from the planner and
+// the machine file; in the program they are plain ASCII, spelled out, in both dialects.
+TEST(PostComments, PlainAsciiInEveryDialect) {
+  for (const std::string machine_file : {"hybrid-3axis.yaml", "multitask-b-axis.yaml"}) {
+    SCOPED_TRACE(machine_file);
+    Machine m = example(machine_file);
+    m.setups.at(1).description = "flipped 180\u00B0 on soft jaws \u2014 \u00F880 chuck";
+    m.setups.at(1).manual_refixture = true;  // so the stop's message is written in both dialects
+    auto actions = sample_actions(m);
+    actions[0].label = "repair deposit near the missing 12 mm\u00B3 \u2713";
+    actions[0].path.moves[1].comment = "layer 1, 0.5 mm\u00B2 at 45\u00B0";
+    actions[1].path.warnings.push_back("3.2 mm\u00B3 left \u2264 0.1 mm from the design \xff");
+    PostOptions options;
+    options.program_name = "plan-1 ((P1 \u222A P9) \u2212 P7)";
+    const std::string text = write_program(actions, m, options);
+    const auto lines = lines_of(text);
+    for (std::size_t i = 0; i < lines.size(); ++i)
+      for (const char c : lines[i])
+        ASSERT_TRUE(static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7f)
+            << "line " << i + 1 << " is not plain ASCII: " << lines[i];
+    const bool fanuc = m.gcode.dialect == hybridctl::config::Dialect::Fanuc;
+    EXPECT_EQ(lines.at(fanuc ? 1 : 0), fanuc ? "O2000 (plan-1 [[P1 + P9] - P7])" : "(plan-1 [[P1 + P9] - P7])");
+    EXPECT_NE(text.find("(repair deposit near the missing 12 mm3 ?)\n"), std::string::npos) << text;
+    EXPECT_NE(text.find("(layer 1, 0.5 mm2 at 45 deg)\n"), std::string::npos) << text;
+    EXPECT_NE(text.find("(warning: 3.2 mm3 left <= 0.1 mm from the design ?)\n"), std::string::npos) << text;
+    EXPECT_NE(text.find(": flipped 180 deg on soft jaws - dia 80 chuck - refixture the part"), std::string::npos)
+        << text;
+    expect_round_trip(actions, m, text);
+  }
+}
+
+TEST(PostComments, CommentTextSpellsOutWhatItCanAndMarksTheRest) {
+  EXPECT_EQ(comment_text("((P1 \u222A P2) \u2212 P3)"), "[[P1 + P2] - P3]");
+  EXPECT_EQ(comment_text("12 mm\u00B3, 30\u00B0"), "12 mm3, 30 deg");
+  EXPECT_EQ(comment_text("a \u2713 b"), "a ? b");        // one '?' per character
+  EXPECT_EQ(comment_text("a \xe2\x88 b \xff"), "a ? b ?");  // a cut-off sequence, a stray byte
+  EXPECT_EQ(comment_text("\xc0\xb3"), "??");                  // an overlong '3' is not a '3'
+  EXPECT_EQ(comment_text("tab\there\nnew (line)"), "tab here new [line]");
 }
 
 TEST(ToolTable, EveryToolAndHeadInLinuxCncFormat) {
