@@ -1,6 +1,8 @@
-// The plan search as it was before issue 15 (commit 2e6a14a, planner/search.cpp): A* with
-// the per-atom bound only, every order of every block, no anytime fallback. Kept here,
-// verbatim but for its namespace, as the baseline planner_bench measures the search against.
+// The plan search as it was before issue 15 (commit 2e6a14a, planner/search/search.cpp): A* with
+// the per-atom bound only, every order of every block, no anytime fallback. Kept here as the
+// baseline planner_bench measures the search against: verbatim but for its namespace, and
+// for the rule of actions (without learned shortfalls or reach) and the duplicate keys, which
+// it takes from the planner as they were.
 
 #include "bench/baseline_astar.hpp"
 
@@ -14,6 +16,8 @@
 #include <unordered_map>
 
 #include "common/hash.hpp"
+#include "planner/problem/actions.hpp"
+#include "planner/search/steps.hpp"
 
 namespace hybridctl::planner::baseline {
 namespace {
@@ -27,26 +31,13 @@ double volume_of_bits(const PlanningProblem& p, const std::vector<std::uint64_t>
   return v;
 }
 
-// The state after applying primitive `i`, and the volume it really changes.
+// The state after applying primitive `i`, and the volume it really changes: the planner's
+// rule of actions (planner/problem/actions.hpp) as it was, with nothing learned and nothing
+// out of a head's reach.
 bool apply(const PlanningProblem& p, const AtomSet& state, int i, AtomSet& next, double& volume) {
-  const PrimitiveSpec& prim = p.primitives[std::size_t(i)];
-  const auto& s = state.words();
-  const auto& a = prim.atoms.words();
-  std::vector<std::uint64_t> changed(s.size());
-  next = state;
-  auto& n = next.words();
-  bool any = false;
-  for (std::size_t w = 0; w < s.size(); ++w) {
-    if (prim.mode == Mode::Additive) {
-      changed[w] = a[w] & ~s[w];
-      n[w] = s[w] | a[w];
-    } else {
-      changed[w] = a[w] & s[w];
-      n[w] = s[w] & ~a[w];
-    }
-    any = any || changed[w];
-  }
-  if (!any) return false;
+  std::vector<std::uint64_t> changed;
+  action_effect(p, state, i, true, next, changed);
+  if (std::all_of(changed.begin(), changed.end(), [](std::uint64_t w) { return w == 0; })) return false;
   volume = volume_of_bits(p, changed);
   return true;
 }
@@ -137,18 +128,7 @@ using KeyHash = WordsHash;
 // Duplicate detection key: state, uses and the last primitive (fixed costs depend on it).
 std::vector<std::uint64_t> key_of(const Node& n) {
   std::vector<std::uint64_t> k = n.state.words();
-  std::uint64_t packed = 0;
-  int shift = 0;
-  for (std::uint8_t u : n.uses) {
-    packed |= std::uint64_t(u) << shift;
-    shift += 8;
-    if (shift == 64) {
-      k.push_back(packed);
-      packed = 0;
-      shift = 0;
-    }
-  }
-  k.push_back(packed);
+  detail::append_uses(k, n.uses);
   k.push_back(std::uint64_t(std::int64_t(n.primitive)));
   return k;
 }

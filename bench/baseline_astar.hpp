@@ -1,7 +1,7 @@
 #pragma once
 // The A* plan search before issue 15, for planner_bench's baseline (baseline_astar.cpp).
 
-#include "planner/search.hpp"
+#include "planner/search/search.hpp"
 
 namespace hybridctl::planner::baseline {
 

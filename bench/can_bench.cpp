@@ -43,7 +43,7 @@ namespace fs = std::filesystem;
 constexpr std::uint32_t kBitrate = 1'000'000;
 
 double theoretical_payload_rate() {
-  const auto frame = sim::can_frame_time(8, kBitrate);
+  const auto frame = sim::wire::can_frame_time(8, kBitrate);
   return 8.0 * 1e6 / double(frame.count());
 }
 

@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "planner/search.hpp"
+#include "planner/search/search.hpp"
 
 namespace hybridctl::bench {
 

@@ -11,11 +11,11 @@
 #include "config/machine_loader.hpp"
 #include "geometry/shapes.hpp"
 #include "geometry/voxelize.hpp"
-#include "planner/atoms.hpp"
-#include "planner/planning.hpp"
-#include "planner/core_proof.hpp"
-#include "planner/search.hpp"
-#include "planner/search_reduce.hpp"
+#include "planner/atoms/atoms.hpp"
+#include "planner/pipeline/planning.hpp"
+#include "planner/search/core_proof.hpp"
+#include "planner/search/search.hpp"
+#include "planner/search/reduce.hpp"
 #include "bench/baseline_astar.hpp"
 #include "bench/plan_problem.hpp"
 
@@ -106,7 +106,7 @@ planner::PlanningProblem synthetic_problem(int n, std::uint32_t seed) {
 }
 
 // Search options with the top k and the expansion limit set, everything else at its
-// default (planner/search.hpp).
+// default (planner/search/search.hpp).
 planner::SearchOptions limits(int top_k, std::int64_t max_expansions) {
   planner::SearchOptions options;
   options.top_k = top_k;
@@ -135,7 +135,7 @@ void BM_AStar(benchmark::State& state) {
 // find_plans as `plan` runs it (one order per block), for the best plan: "exact" = 1 when
 // it is proven optimal, else "gap_pct" is its proven distance from the optimum. The
 // expansion limit (not a time budget) keeps the result the same from run to run. "kept"
-// and "groups": the primitives and atoms the search runs on (planner/search_reduce.hpp).
+// and "groups": the primitives and atoms the search runs on (planner/search/reduce.hpp).
 void BM_Search(benchmark::State& state) {
   const auto p = synthetic_problem(int(state.range(0)), std::uint32_t(state.range(1)));
   planner::SearchOptions options = limits(int(state.range(2)), state.range(3));
@@ -207,7 +207,7 @@ BENCHMARK(BM_SearchMachine)
     ->UseRealTime()
     ->Iterations(1);
 
-// The proof from a few atoms that no plan exists (planner/core_proof.hpp) on the same
+// The proof from a few atoms that no plan exists (planner/search/core_proof.hpp) on the same
 // recorded problems, as `plan` runs it before the search: outcome 0 proven, 1 a replayed
 // plan makes the part, 2 the limits. Compare its time with BM_SearchMachine's in the same
 // run: on the overhang the search stops at its limits without a plan.

@@ -24,10 +24,10 @@
 #include "config/machine_loader.hpp"
 #include "geometry/mesh.hpp"
 #include "geometry/voxelize.hpp"
-#include "planner/atoms.hpp"
-#include "planner/machine_primitives.hpp"
-#include "planner/memory_estimate.hpp"
-#include "planner/primitive_shapes.hpp"
+#include "planner/atoms/atoms.hpp"
+#include "planner/primitives/machine_primitives.hpp"
+#include "planner/pipeline/memory_estimate.hpp"
+#include "planner/primitives/shapes.hpp"
 
 namespace {
 
@@ -40,7 +40,7 @@ struct Job {
   geometry::IndexBox domain;
 };
 
-// The design and domain as plan_part makes them (planner/planning.cpp, voxelize_design).
+// The design and domain as plan_part makes them (planner/pipeline/planning.cpp, voxelize_design).
 Job job_for(int part, double voxel = 0) {
   const std::string root = HYBRIDCTL_SOURCE_DIR;
   const std::string name = part == 0 ? "bracket.stl" : "overhang.stl";
@@ -107,7 +107,7 @@ void BM_ReferenceRemovals(benchmark::State& state) {
 
 // Everything plan_part allocates before the search, at a voxel size of range(1) / 100 mm:
 // primitives, atoms, the tolerance zone and the atoms' measures; next to the estimate
-// `plan` checks against --memory-budget (planner/memory_estimate.hpp).
+// `plan` checks against --memory-budget (planner/pipeline/memory_estimate.hpp).
 void BM_GridPhases(benchmark::State& state) {
   const double voxel = double(state.range(1)) / 100.0;
   const Job j = job_for(int(state.range(0)), voxel);

@@ -85,36 +85,36 @@ std::string make_segment_dir(const BridgeOptions& o) {
 }
 
 struct Endpoints {
-  std::unique_ptr<sim::ModbusTcpServer> modbus;
-  std::unique_ptr<sim::SocketcandServer> socketcand;
-  std::unique_ptr<sim::SocketCanEndpoint> socketcan;
-  std::vector<sim::WireEndpoint*> all;
+  std::unique_ptr<sim::wire::ModbusTcpServer> modbus;
+  std::unique_ptr<sim::wire::SocketcandServer> socketcand;
+  std::unique_ptr<sim::wire::SocketCanEndpoint> socketcan;
+  std::vector<sim::wire::WireEndpoint*> all;
 };
 
 Endpoints open_endpoints(const BridgeOptions& o, protocol::ControllerPort& controller,
                          const std::function<void(const std::string&)>& say) {
   const auto modbus_at = listen_address("--modbus", o.modbus, o.allow_remote);
   const auto socketcand_at = listen_address("--socketcand", o.socketcand, o.allow_remote);
-  sim::CanNodeOptions node;
+  sim::wire::CanNodeOptions node;
   node.node = static_cast<std::uint8_t>(o.node);
   Endpoints e;
   if (!o.socketcan.empty()) {
-    e.socketcan = std::make_unique<sim::SocketCanEndpoint>(controller, o.socketcan, node, o.faults);
+    e.socketcan = std::make_unique<sim::wire::SocketCanEndpoint>(controller, o.socketcan, node, o.faults);
     e.all.push_back(e.socketcan.get());
     say("listening socketcan " + o.socketcan);
   }
   if (modbus_at) {
-    sim::ModbusServerOptions modbus;
+    sim::wire::ModbusServerOptions modbus;
     modbus.faults = o.faults;
-    e.modbus = std::make_unique<sim::ModbusTcpServer>(controller, modbus_at->host, modbus_at->port, modbus);
+    e.modbus = std::make_unique<sim::wire::ModbusTcpServer>(controller, modbus_at->host, modbus_at->port, modbus);
     e.all.push_back(e.modbus.get());
     say("listening modbus-tcp " + e.modbus->address() + ":" + std::to_string(e.modbus->port()));
   }
   if (socketcand_at) {
-    sim::SocketcandOptions cand;
+    sim::wire::SocketcandOptions cand;
     cand.node = node;
     cand.faults = o.faults;
-    e.socketcand = std::make_unique<sim::SocketcandServer>(controller, socketcand_at->host, socketcand_at->port, cand);
+    e.socketcand = std::make_unique<sim::wire::SocketcandServer>(controller, socketcand_at->host, socketcand_at->port, cand);
     e.all.push_back(e.socketcand.get());
     say("listening socketcand " + e.socketcand->address() + ":" + std::to_string(e.socketcand->port()));
   }
@@ -123,7 +123,7 @@ Endpoints open_endpoints(const BridgeOptions& o, protocol::ControllerPort& contr
 
 // One thread: the wire servers' descriptors in one poll(), LinuxCNC's status read every
 // status period (the controller is not thread-safe; everything happens here).
-void run_loop(const std::vector<sim::WireEndpoint*>& endpoints, LinuxcncController& controller,
+void run_loop(const std::vector<sim::wire::WireEndpoint*>& endpoints, LinuxcncController& controller,
               std::chrono::milliseconds status_period) {
   std::vector<pollfd> fds;
   std::vector<std::size_t> counts(endpoints.size());
@@ -137,7 +137,7 @@ void run_loop(const std::vector<sim::WireEndpoint*>& endpoints, LinuxcncControll
     }
     Clock::time_point now = Clock::now();
     Clock::time_point wake = next_tick;
-    for (const sim::WireEndpoint* e : endpoints) wake = std::min(wake, e->next_deadline());
+    for (const sim::wire::WireEndpoint* e : endpoints) wake = std::min(wake, e->next_deadline());
     const auto wait = std::max(std::chrono::nanoseconds(0), std::chrono::nanoseconds(wake - now));
     timespec ts{static_cast<time_t>(wait.count() / 1'000'000'000), static_cast<long>(wait.count() % 1'000'000'000)};
     const int rc = ::ppoll(fds.data(), fds.size(), &ts, nullptr);
@@ -154,7 +154,7 @@ void run_loop(const std::vector<sim::WireEndpoint*>& endpoints, LinuxcncControll
         at += counts[i];
       }
     }
-    for (sim::WireEndpoint* e : endpoints) e->tick(now);
+    for (sim::wire::WireEndpoint* e : endpoints) e->tick(now);
   }
 }
 

@@ -31,7 +31,7 @@ struct BridgeOptions {
   double connect_timeout_s = 30;  ///< how long to wait for LinuxCNC at startup
   std::string line_log;       ///< every line LinuxCNC executed, in order
   std::string python = "/usr/bin/python3";
-  sim::FaultOptions faults;   ///< the wire servers' fault injection (drop_every, ...)
+  sim::wire::FaultOptions faults;   ///< the wire servers' fault injection (drop_every, ...)
 };
 
 struct BridgeOutcome {

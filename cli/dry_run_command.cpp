@@ -29,8 +29,8 @@
 #include "geometry/vdb_file.hpp"
 #include "plan/plan_file.hpp"
 #include "plan/deviation.hpp"
-#include "planner/candidate_execution.hpp"
-#include "planner/plan_report.hpp"
+#include "planner/pipeline/candidate_execution.hpp"
+#include "planner/pipeline/plan_report.hpp"
 #include "validation/plan_validator.hpp"
 
 namespace hybridctl::cli {
@@ -181,10 +181,7 @@ bool dry_run_plan(const DryRunArgs& a, const plan::PlanFile& file, int rank, con
   // 3. As built versus as planned and versus the design.
   const geometry::Solid planned_shape = plan::plan_states(file, plan).back();
   const geometry::Solid built = geometry::read_vdb(as_built);
-  geometry::Solid built_here(file.lattice, file.domain);
-  built.for_each_voxel([&](geometry::Index3 v) {
-    if (file.domain.contains(v)) built_here.set(v);
-  });
+  const geometry::Solid built_here = copied_onto(built, file.lattice, file.domain);
   const geometry::Solid extra = subtract(built_here, planned_shape), missing = subtract(planned_shape, built_here);
   const plan::Deviation d = plan::measure_deviation(built_here, file.design, file.domain, file.tolerance);
   std::printf("as built    %.1f mm³ (planned %.1f mm³): %.1f mm³ beyond the plan, %.1f mm³ of it missing\n",
@@ -214,7 +211,7 @@ int run_dry_run(const DryRunArgs& a) {
   const planner::PlanningResult planned = planner::plan_part(geometry::read_stl(a.part), a.part, machine, options);
   const planner::ReportSources sources{a.part, a.machine, machine.name, machine_text};
   std::fputs(planner::plan_summary(planned, sources).c_str(), stdout);
-  if (!planned.verdict.manufacturable || planned.plans.empty()) return kNotManufacturable;
+  if (!planned.verdict.manufacturable() || planned.plans.empty()) return kNotManufacturable;
   const fs::path plan_dir = out / "plan";
   planner::write_plan_directory(planned, sources, plan_dir);
   const plan::PlanFile file = planner::to_plan_file(planned, sources, plan_dir);

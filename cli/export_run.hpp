@@ -12,7 +12,7 @@ struct ExportRequest {
   std::string output;   // directory for the programs
   int rank = 1;         // which plan
   std::string dialect;  // empty: the machine file's
-  std::string machine;  // empty: the machine plan.json embeds (planner/plan_machine.hpp)
+  std::string machine;  // empty: the machine plan.json embeds (plan/plan_machine.hpp)
   bool machine_override = false;  // take `machine` even when it is another machine
 };
 

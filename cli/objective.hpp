@@ -1,6 +1,6 @@
 #pragma once
 // --objective time|money|cost-factor: what `plan` and `dry-run` rank plans by
-// (planner/costing.hpp, docs/costs.md); default the machine file's.
+// (planner/costing/costs.hpp, docs/costs.md); default the machine file's.
 
 #include <CLI/CLI.hpp>
 

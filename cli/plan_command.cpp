@@ -11,8 +11,8 @@
 #include "cli/report_job.hpp"
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
-#include "planner/candidate_execution.hpp"
-#include "planner/plan_report.hpp"
+#include "planner/pipeline/candidate_execution.hpp"
+#include "planner/pipeline/plan_report.hpp"
 #include "validation/plan_validator.hpp"
 
 namespace hybridctl::cli {
@@ -101,7 +101,7 @@ int run_plan(const PlanArgs& args) {
     total += seconds;
   }
   std::printf(" total %.2f s\n", total);
-  const bool exports = !args.export_dir.empty() && result.verdict.manufacturable && !result.plans.empty();
+  const bool exports = !args.export_dir.empty() && result.verdict.manufacturable() && !result.plans.empty();
   // The plan in memory is the plan on disk (PlanInMemory tests): report and export need not
   // read its solids back.
   const plan::PlanFile in_memory =
@@ -120,7 +120,7 @@ int run_plan(const PlanArgs& args) {
     const int code = export_plan_programs(in_memory, request);
     if (code != kSuccess) return code;
   }
-  return result.verdict.manufacturable && !result.plans.empty() ? int(kSuccess) : int(kNotManufacturable);
+  return result.verdict.manufacturable() && !result.plans.empty() ? int(kSuccess) : int(kNotManufacturable);
 }
 
 }  // namespace

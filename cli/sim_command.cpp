@@ -28,13 +28,13 @@ void print_line(const std::string& line) {
   std::fflush(stdout);
 }
 
-int run_serve(const sim::ServeOptions& options) {
-  sim::ServeOutcome end;
+int run_serve(const sim::wire::ServeOptions& options) {
+  sim::wire::ServeOutcome end;
   try {
-    end = sim::serve(options, print_line);
-  } catch (const sim::ServeRefused& e) {
+    end = sim::wire::serve(options, print_line);
+  } catch (const sim::wire::ServeRefused& e) {
     std::fprintf(stderr, "hybridctl sim serve: error: %s\n", e.what());
-    return e.reason() == sim::ServeRefused::Reason::Usage ? kUsage : kBadInput;
+    return e.reason() == sim::wire::ServeRefused::Reason::Usage ? kUsage : kBadInput;
   }
   const sim::ControllerReport& report = end.controller;
   std::printf("stopped (%s): %u chunks accepted, %u executed, %u lines executed, %.3f s virtual time, state %s\n",
@@ -47,7 +47,7 @@ int run_serve(const sim::ServeOptions& options) {
 }  // namespace
 
 void add_sim_command(CLI::App& app, Runner& runner) {
-  auto r = std::make_shared<sim::ServeOptions>();
+  auto r = std::make_shared<sim::wire::ServeOptions>();
   auto memory_budget_text = std::make_shared<std::string>();
   auto* sim = app.add_subcommand("sim", "The machine simulator");
   sim->require_subcommand(1);

@@ -4,6 +4,7 @@
 
 #include <optional>
 #include <string_view>
+#include <utility>
 
 namespace hybridctl::config {
 
@@ -25,24 +26,22 @@ enum class PrimitiveKind {
 enum class Mode { Additive, Subtractive };
 
 // Names as written in the machine file and plan.json.
+inline constexpr std::pair<PrimitiveKind, std::string_view> kPrimitiveKindNames[] = {
+    {PrimitiveKind::RawStock, "raw-stock"}, {PrimitiveKind::UAm, "u-am"},       {PrimitiveKind::OAm, "o-am"},
+    {PrimitiveKind::SmMax, "sm-max"},       {PrimitiveKind::SmCons, "sm-cons"}, {PrimitiveKind::File, "file"}};
+
 constexpr std::string_view to_string(PrimitiveKind k) {
-  switch (k) {
-    case PrimitiveKind::RawStock: return "raw-stock";
-    case PrimitiveKind::File: return "file";
-    case PrimitiveKind::UAm: return "u-am";
-    case PrimitiveKind::OAm: return "o-am";
-    case PrimitiveKind::SmMax: return "sm-max";
-    case PrimitiveKind::SmCons: return "sm-cons";
-  }
+  for (const auto& [kind, name] : kPrimitiveKindNames)
+    if (kind == k) return name;
   return "?";
 }
+
 constexpr std::string_view to_string(Mode m) { return m == Mode::Additive ? "additive" : "subtractive"; }
 
 // The kind a name stands for ("raw-stock", "u-am", ...); none for any other name.
 constexpr std::optional<PrimitiveKind> primitive_kind_named(std::string_view name) {
-  for (PrimitiveKind k : {PrimitiveKind::RawStock, PrimitiveKind::UAm, PrimitiveKind::OAm, PrimitiveKind::SmMax,
-                          PrimitiveKind::SmCons, PrimitiveKind::File})
-    if (to_string(k) == name) return k;
+  for (const auto& [kind, kind_name] : kPrimitiveKindNames)
+    if (kind_name == name) return kind;
   return std::nullopt;
 }
 

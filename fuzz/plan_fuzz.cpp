@@ -1,4 +1,4 @@
-// Fuzz target: the plan.json reader (planner/plan_file.hpp: parse_plan_file, the in-memory
+// Fuzz target: the plan.json reader (plan/plan_file.hpp: parse_plan_file, the in-memory
 // form of read_plan_file) on arbitrary text, then the states each plan passes through
 // (plan_states), as `hybridctl export` and `hybridctl run` do with a plan they read.
 //

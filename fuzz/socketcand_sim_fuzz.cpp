@@ -26,20 +26,20 @@ namespace {
 bool same_frame(const can::CanFrame& a, const can::CanFrame& b) { return a == b; }
 
 void check_element(std::string_view element) {
-  const sim::SocketcandParse p = sim::parse_socketcand_element(element);
+  const sim::wire::SocketcandParse p = sim::wire::parse_socketcand_element(element);
   if (!p.request) {
     FUZZ_CHECK(!p.error.empty(), "a refused element says why");
     FUZZ_CHECK(p.error.find_first_of("<>\r\n") == std::string::npos, "an error text fits in < error ... >");
     return;
   }
   FUZZ_CHECK(p.error.empty(), "an accepted element has no error");
-  if (p.request->kind != sim::SocketcandRequest::Kind::Send) return;
+  if (p.request->kind != sim::wire::SocketcandRequest::Kind::Send) return;
   const can::CanFrame& frame = p.request->frame;
   FUZZ_CHECK(frame.len <= 8 && frame.id <= 0x1FFFFFFF, "a sent frame is a CAN frame");
 
   // Server -> host: the frame element every raw-mode client gets.
   drivers::SocketcandReader reader;
-  reader.feed(sim::format_socketcand_frame(frame, 1700000000, 123456));
+  reader.feed(sim::wire::format_socketcand_frame(frame, 1700000000, 123456));
   const auto words = reader.next();
   FUZZ_CHECK(words.has_value(), "the server's frame element is one element");
   const drivers::SocketcandFrame host = drivers::parse_socketcand_frame(*words);
@@ -47,8 +47,8 @@ void check_element(std::string_view element) {
   FUZZ_CHECK(host.extended == (frame.id > 0x7FF), "29-bit identifiers are marked as such");
 
   // Host -> server: the host's send element for the same frame.
-  const sim::SocketcandParse back = sim::parse_socketcand_element(drivers::format_socketcand_send(frame));
-  FUZZ_CHECK(back.request && back.request->kind == sim::SocketcandRequest::Kind::Send &&
+  const sim::wire::SocketcandParse back = sim::wire::parse_socketcand_element(drivers::format_socketcand_send(frame));
+  FUZZ_CHECK(back.request && back.request->kind == sim::wire::SocketcandRequest::Kind::Send &&
                  same_frame(back.request->frame, frame),
              "the server reads the frame the host sent");
 }
@@ -61,12 +61,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // SocketcandServer reads a client with): pieces lie inside the input, in order, and every
   // element is checked.
   const char* last_end = in.data();
-  const std::size_t used = sim::split_socketcand_stream(in, 256, [&](const sim::SocketcandPiece& piece) {
+  const std::size_t used = sim::wire::split_socketcand_stream(in, 256, [&](const sim::wire::SocketcandPiece& piece) {
     FUZZ_CHECK(piece.text.data() >= last_end && piece.text.data() + piece.text.size() <= in.data() + in.size(),
                "pieces lie inside the input, in order");
     FUZZ_CHECK(!piece.text.empty(), "no empty piece");
     last_end = piece.text.data() + piece.text.size();
-    if (piece.kind == sim::SocketcandPiece::Kind::Element) {
+    if (piece.kind == sim::wire::SocketcandPiece::Kind::Element) {
       FUZZ_CHECK(piece.text.front() == '<' && piece.text.back() == '>', "an element is bracketed");
       check_element(piece.text);
     }

@@ -26,6 +26,7 @@
 #include <stdexcept>
 
 #include "geometry/morphology_internal.hpp"
+#include "geometry/sliding_extremum.hpp"
 
 namespace hybridctl::geometry {
 
@@ -212,14 +213,13 @@ void disc_minimum(const std::vector<std::int32_t>& h, const Columns& q, double r
       for (int dv = -n; dv <= n; ++dv) {
         const int w = whole_radius(r2 - double(dv) * double(dv));
         const std::int32_t* in = h.data() + q.index(q.u0, v + dv);
-        // Van Herk / Gil-Werman: minima within blocks of 2w + 1 from each end.
-        const int k = 2 * w + 1, len = q.width();
-        for (int i = 0; i < len; ++i) forward[std::size_t(i)] = i % k == 0 ? in[i] : std::min(forward[std::size_t(i) - 1], in[i]);
-        for (int i = len - 1; i >= 0; --i)
-          backward[std::size_t(i)] = (i % k == k - 1 || i == len - 1) ? in[i] : std::min(backward[std::size_t(i) + 1], in[i]);
+        // The minimum over the row's window of 2w + 1 (geometry/sliding_extremum.hpp).
+        const int k = 2 * w + 1;
+        const auto smaller = [](std::int32_t a, std::int32_t b) { return std::min(a, b); };
+        block_extrema(in, q.width(), k, forward.data(), backward.data(), smaller);
         for (int u = d.u0; u < d.u1; ++u) {
           const int i = u - q.u0;
-          const std::int32_t m = std::min(backward[std::size_t(i - w)], forward[std::size_t(i + w)]);
+          const std::int32_t m = window_extremum(forward.data(), backward.data(), i - w, k, smaller);
           const std::int32_t value = m <= kNoHeight ? kNoHeight : std::int32_t(std::int64_t(m) + add);
           o[u - d.u0] = std::min(o[u - d.u0], value);
         }

@@ -204,6 +204,14 @@ Solid unite(const Solid& a, const Solid& b) {
   return combine_words(a, b, box_union(a.storage_box(), b.storage_box()), kUnion);
 }
 
+Solid copied_onto(const Solid& a, const Lattice& lattice, const IndexBox& box) {
+  Solid out(lattice, box);
+  a.for_each_voxel([&](Index3 v) {
+    if (box.contains(v)) out.set(v);
+  });
+  return out;
+}
+
 Solid intersect(const Solid& a, const Solid& b) {
   require_same_lattice(a, b, "intersection");
   return combine_words(a, b, box_intersection(a.storage_box(), b.storage_box()), kIntersection);

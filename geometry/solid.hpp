@@ -135,6 +135,10 @@ Solid intersect(const Solid& a, const Solid& b);
 Solid subtract(const Solid& a, const Solid& b);  // a minus b
 // The voxels of `domain` not in `a`.
 Solid complement(const Solid& a, const IndexBox& domain);
+// The voxels of `a` inside `box`, stored over `box` on `lattice`, by their indices: for a
+// solid whose lattice differs from the one wanted only by the rounding of its origin (read
+// back from a .vdb) or that lies in another frame's box.
+Solid copied_onto(const Solid& a, const Lattice& lattice, const IndexBox& box);
 
 enum class Axis { X, Y, Z };
 

@@ -1,6 +1,6 @@
 #pragma once
 // The layer rule: what a head builds without support, on voxels. The one definition the
-// planner's additive primitives (planner/support.hpp) and the simulator's deposition
+// planner's additive primitives (planner/primitives/support.hpp) and the simulator's deposition
 // (sim/material.cpp) both apply, from the head's `support` keys (config::SupportLimits).
 // docs/support.md explains the model with figures.
 //

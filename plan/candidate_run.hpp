@@ -2,7 +2,7 @@
 // What executing a candidate plan from the raw stock showed (validation/,
 // docs/validation.md): the contract between validation, which runs the plan's G-code on
 // the simulated machine, and the planner, which learns from it what its primitives do not
-// do (planner/shortfall.hpp). In plan.json's terms, so that neither needs the other.
+// do (planner/pipeline/shortfall.hpp). In plan.json's terms, so that neither needs the other.
 
 #include <cstddef>
 #include <functional>

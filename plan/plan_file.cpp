@@ -74,10 +74,7 @@ class Node {
 // clipped to the domain.
 geometry::Solid on_plan_grid(const geometry::Solid& s, const geometry::Lattice& lattice, const geometry::IndexBox& domain) {
   if (s.lattice() == lattice) return intersect(s, geometry::Solid::filled(lattice, domain));
-  geometry::Solid out(lattice, domain);  // the same grid up to rounding of the origin
-  s.for_each_voxel([&](geometry::Index3 v) {
-    if (domain.contains(v)) out.set(v);
-  });
+  geometry::Solid out = copied_onto(s, lattice, domain);  // the same grid up to rounding of the origin
   return out;
 }
 

@@ -13,10 +13,7 @@ AsBuilt as_built(const plan::PlanFile& file, const std::filesystem::path& as_bui
                      " mm voxels that is not the plan's lattice (" + std::to_string(file.lattice.voxel_size) +
                      " mm voxels from its origin): expected the as-built stock of a run of this plan");
   AsBuilt out;
-  out.built = geometry::Solid(file.lattice, file.domain);
-  read.for_each_voxel([&](geometry::Index3 v) {
-    if (file.domain.contains(v)) out.built.set(v);
-  });
+  out.built = copied_onto(read, file.lattice, file.domain);
   const geometry::Solid over = subtract(out.built, file.design), under = subtract(file.design, out.built);
   // Within the tolerance as plan::measure_deviation counts it: voxel centres at most the
   // tolerance plus half a voxel apart (the distance to the surface between the voxels).

@@ -21,11 +21,7 @@ Solid turned(const Solid& solid, const IndexBox& domain, config::Approach approa
   const IndexBox box = to_work ? toolpaths::part_to_work(domain, solid.lattice(), approach)
                                : toolpaths::work_to_part(domain, solid.lattice(), approach);
   const Solid t = to_work ? toolpaths::part_to_work(solid, approach) : toolpaths::work_to_part(solid, approach);
-  Solid out(solid.lattice(), box);
-  t.for_each_voxel([&](geometry::Index3 v) {
-    if (box.contains(v)) out.set(v);
-  });
-  return out;
+  return copied_onto(t, solid.lattice(), box);
 }
 
 void add(SimulationReport& total, const SimulationReport& part) {

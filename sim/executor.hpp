@@ -70,7 +70,7 @@ class ProgramExecutor {
 
   // The voxels cuts must spare from the next line on (part frame), in place of
   // ExecutorOptions::protected_region: validation protects per action what that action
-  // keeps of the design (planner/start_stock.hpp).
+  // keeps of the design (plan/start_stock.hpp).
   void set_protected_region(std::optional<geometry::Solid> protected_region);
 
   const gcode::ModalState& state() const;

@@ -92,7 +92,7 @@ class MaterialSimulation {
   const geometry::Solid& stock() const { return stock_; }
   const std::optional<geometry::Solid>& protected_region() const { return protected_; }
   // The voxels cuts must spare from the next move on (same rules as the constructor's):
-  // what a plan protects changes from action to action (planner/start_stock.hpp).
+  // what a plan protects changes from action to action (plan/start_stock.hpp).
   void set_protected_region(std::optional<geometry::Solid> protected_region);
   const SimulationReport& report() const { return report_; }
   const SimulationOptions& options() const { return options_; }

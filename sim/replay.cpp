@@ -36,11 +36,7 @@ ReplayResult replay_program(std::string_view text, const config::Machine& machin
   if (built.storage_box() == domain) {
     result.stock = built;
   } else {
-    geometry::Solid out(stock.lattice(), domain);
-    built.for_each_voxel([&](geometry::Index3 v) {
-      if (domain.contains(v)) out.set(v);
-    });
-    result.stock = std::move(out);
+    result.stock = copied_onto(built, stock.lattice(), domain);
   }
   return result;
 }

@@ -526,7 +526,7 @@ void DepositionBuilder::deposit_layer(int layer, double zb) {
   // A pass the plan does not count on this action for (earlier actions were to lay it) is
   // left out where the nozzle body over it would meet material beside it: the machine
   // would stop there (body_collision), and the part is judged by what it lacks instead.
-  // The passes the plan counts on are the planner's to keep clear (planner/deposit_reach.hpp).
+  // The passes the plan counts on are the planner's to keep clear (planner/atoms/deposit_reach.hpp).
   const bool check_body = counted_ && head_.nozzle;
   int counted_top = 0;
   const SliceMask counted_here = check_body ? layer_region(*counted_, zb, counted_top) : empty_mask_;

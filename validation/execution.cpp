@@ -254,7 +254,7 @@ class IncrementalRun {
       feed(prefix_, prefix_.actions.back().last_line);
     }
     const bool wrong = !made.program.path.defects.empty() || !errors_.empty() || !executor_.report().incidents.empty();
-    if (options_.run_until == RunUntil::FirstFailingAction && wrong) throw Stopped{made.step};
+    if (options_.run_until == RunUntil::FirstFailingAction && wrong) throw Stopped{made.step, std::nullopt};
     // Only a prefix that went right is kept: it is the same whatever RunUntil says (and
     // whatever the plan does after it).
     right_ = right_ && !wrong;

@@ -12,7 +12,7 @@
 //
 // This library sits above toolpaths and sim and knows plans only as plan files
 // (docs/architecture.md); the planner offers it candidates through a plan::CandidateExecutor
-// (validation/plan_validator.hpp, planner/candidate_execution.hpp).
+// (validation/plan_validator.hpp, planner/pipeline/candidate_execution.hpp).
 
 #include <string>
 #include <vector>

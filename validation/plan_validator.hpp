@@ -3,7 +3,7 @@
 // candidate plan the search finds is exported and executed (validation/execution.hpp)
 // before it is offered; what the run showed goes back to the planner, which rejects the
 // candidate on its reasons and learns from the material it left
-// (planner/candidate_execution.hpp). Knows plan files, not the planner.
+// (planner/pipeline/candidate_execution.hpp). Knows plan files, not the planner.
 //
 //   planner::PlanningOptions options;
 //   planner::validate_by_execution(options, validation::plan_validator(machine), machine.name);

@@ -168,12 +168,14 @@
     const part = String(data.part || 'part').split('/').pop();
     h.append(el('h1', '', part));
     const v = data.verdict || {};
-    // As `plan` says it: undecided when the search stopped at its limits or learned from
-    // rejected candidates, and nothing decided the part before the search.
-    const undecided = !v.manufacturable && !v.decided_without_search &&
-                      ((data.search && data.search.limit_reached) || (data.learned || []).length > 0);
-    h.append(el('span', 'badge ' + (v.manufacturable ? 'ok' : 'bad'),
-                v.manufacturable ? 'manufacturable' : undecided ? 'UNDECIDED' : 'NOT manufacturable'));
+    // plan.json's outcome, as `plan` says it. Plans written before it carried one: undecided
+    // when the search stopped at its limits or learned from rejected candidates, and
+    // nothing decided the part before the search.
+    const outcome = v.outcome || (v.manufacturable ? 'manufacturable'
+                    : !v.decided_without_search && ((data.search && data.search.limit_reached) ||
+                                                    (data.learned || []).length > 0) ? 'undecided' : 'not-manufacturable');
+    h.append(el('span', 'badge ' + (outcome === 'manufacturable' ? 'ok' : 'bad'),
+                outcome === 'manufacturable' ? 'manufacturable' : outcome === 'undecided' ? 'UNDECIDED' : 'NOT manufacturable'));
     const facts = [(data.machine && data.machine.name) || '', 'voxel ' + fmt(data.voxel_size, 2) + ' mm',
                    'tolerance ' + fmt(data.tolerance, 2) + ' mm', (data.atoms ? data.atoms.count : 0) + ' atoms',
                    (data.primitives || []).length + ' primitives', (data.plans || []).length + ' plans'];
@@ -561,7 +563,7 @@
     const all = new THREE.Box3();
     for (const name of ['design', 'violating']) if (layers[name]) all.union(new THREE.Box3().setFromObject(layers[name]));
     frame(all);
-    setCaption((data.verdict && data.verdict.manufacturable) ? 'Design' : 'Design and its offending atoms');
+    setCaption((data.verdict && (data.verdict.outcome || (data.verdict.manufacturable ? 'manufacturable' : '')) === 'manufacturable') ? 'Design' : 'Design and its offending atoms');
     updateLegend();
     renderer.render(scene, camera);
     drawThumbnails().then(() => { report.ready = true; requestRender(); });

@@ -4,7 +4,7 @@
 
 #include "sim/controller.hpp"
 
-namespace hybridctl::sim {
+namespace hybridctl::sim::wire {
 
 namespace can = protocol::can;
 
@@ -137,4 +137,4 @@ void CanNode::tick(CanMicros now) {
 
 CanMicros CanNode::next_deadline() const { return next_status_; }
 
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire

@@ -27,7 +27,7 @@
 #include "protocol/can_transfer.hpp"
 #include "protocol/controller_port.hpp"
 
-namespace hybridctl::sim {
+namespace hybridctl::sim::wire {
 
 
 using CanMicros = protocol::can::Micros;
@@ -122,4 +122,4 @@ class CanBusClock {
 /// Microseconds on the steady clock (the time base the CAN state machines are given).
 CanMicros can_now();
 
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire

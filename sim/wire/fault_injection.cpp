@@ -2,7 +2,7 @@
 
 #include <charconv>
 
-namespace hybridctl::sim {
+namespace hybridctl::sim::wire {
 
 std::string parse_line_list(const std::string& text, std::vector<std::uint32_t>& out) {
   std::size_t start = 0;
@@ -20,4 +20,4 @@ std::string parse_line_list(const std::string& text, std::vector<std::uint32_t>&
   }
 }
 
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire

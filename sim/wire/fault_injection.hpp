@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-namespace hybridctl::sim {
+namespace hybridctl::sim::wire {
 
 struct FaultOptions {
   std::uint32_t drop_every = 0;       ///< close the client's connection at every N-th request (RTU: no reply); 0: never
@@ -88,4 +88,4 @@ class FaultInjector {
 /// Parses "L" or "L1,L2,..." (positive integers) into `out`; returns an error message or "".
 std::string parse_line_list(const std::string& text, std::vector<std::uint32_t>& out);
 
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire

@@ -29,7 +29,7 @@
 #include "protocol/modbus_map.hpp"
 #include "sim/controller.hpp"
 
-namespace hybridctl::sim {
+namespace hybridctl::sim::wire {
 namespace {
 
 namespace mb = protocol::modbus;
@@ -456,4 +456,4 @@ SteadyTime ModbusRtuServer::next_deadline() const {
   return SteadyTime::max();
 }
 
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire

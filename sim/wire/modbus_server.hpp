@@ -38,7 +38,7 @@
 #include "sim/wire/fault_injection.hpp"
 #include "sim/wire/serve_loop.hpp"
 
-namespace hybridctl::sim {
+namespace hybridctl::sim::wire {
 
 
 struct ModbusCounters {
@@ -121,4 +121,4 @@ class ModbusRtuServer final : public WireEndpoint {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire

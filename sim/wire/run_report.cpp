@@ -9,7 +9,7 @@
 #include "common/error.hpp"
 #include "protocol/codes.hpp"
 
-namespace hybridctl::sim {
+namespace hybridctl::sim::wire {
 namespace {
 
 using nlohmann::json;
@@ -162,4 +162,4 @@ void write_run_report(const RunReport& report, const std::filesystem::path& path
   file.commit();
 }
 
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire

@@ -16,7 +16,7 @@
 #include "sim/wire/socketcan_endpoint.hpp"
 #include "sim/wire/socketcand_server.hpp"
 
-namespace hybridctl::sim {
+namespace hybridctl::sim::wire {
 
 struct ModbusTcpReport {
   std::string address;  // HOST:PORT bound
@@ -69,4 +69,4 @@ std::string run_report_json(const RunReport& report);
 // Writes run_report_json() to `path` atomically. Throws InputError when it cannot.
 void write_run_report(const RunReport& report, const std::filesystem::path& path);
 
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire

@@ -26,7 +26,7 @@
 #include "sim/wire/socketcan_endpoint.hpp"
 #include "sim/wire/socketcand_server.hpp"
 
-namespace hybridctl::sim {
+namespace hybridctl::sim::wire {
 namespace {
 
 namespace fs = std::filesystem;
@@ -102,7 +102,7 @@ std::string stock_from_plan(const ServeOptions& o, const config::Machine& machin
   const plan::PlanFilePrimitive* first =
       plan.actions.empty() ? nullptr : &file.primitives.at(std::size_t(plan.actions.front().primitive));
   std::string described;
-  // As validation executes plans (planner/start_stock.hpp): over the plan's domain, the
+  // As validation executes plans (plan/start_stock.hpp): over the plan's domain, the
   // build plate under the first deposit of a plan that starts with deposition.
   options.stock = plan::start_stock(file, plan, machine);
   if (first && first->raw_stock()) {
@@ -319,4 +319,4 @@ ServeOutcome serve(const ServeOptions& o, const std::function<void(const std::st
   return outcome;
 }
 
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire

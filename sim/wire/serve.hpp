@@ -16,7 +16,7 @@
 #include "sim/controller.hpp"
 #include "sim/wire/fault_injection.hpp"
 
-namespace hybridctl::sim {
+namespace hybridctl::sim::wire {
 
 struct ServeOptions {
   std::string machine;     // machine file (YAML)
@@ -73,4 +73,4 @@ struct ServeOutcome {
 /// without SocketCAN.
 ServeOutcome serve(const ServeOptions& options, const std::function<void(const std::string&)>& say);
 
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire

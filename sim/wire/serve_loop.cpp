@@ -9,7 +9,7 @@
 
 #include "sim/controller.hpp"
 
-namespace hybridctl::sim {
+namespace hybridctl::sim::wire {
 
 ServeLoop::ServeLoop(Controller& controller, ServeLoopOptions options)
     : controller_(controller), options_(std::move(options)) {
@@ -89,4 +89,4 @@ ServeExit ServeLoop::run(const std::atomic<bool>& stop) {
   return result;
 }
 
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire

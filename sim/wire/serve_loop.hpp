@@ -19,8 +19,10 @@
 #include <poll.h>
 
 namespace hybridctl::sim {
-
 class Controller;
+}
+
+namespace hybridctl::sim::wire {
 
 using SteadyClock = std::chrono::steady_clock;
 using SteadyTime = SteadyClock::time_point;
@@ -86,4 +88,4 @@ class ServeLoop {
   double real_seconds_ = 0;
 };
 
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire

@@ -14,7 +14,7 @@
 
 #include "sim/controller.hpp"
 
-namespace hybridctl::sim {
+namespace hybridctl::sim::wire {
 
 namespace can = protocol::can;
 
@@ -173,4 +173,4 @@ SteadyTime SocketCanEndpoint::next_deadline() const {
   return SteadyTime(std::chrono::duration_cast<SteadyClock::duration>(t));
 }
 
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire

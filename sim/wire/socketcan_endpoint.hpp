@@ -17,7 +17,7 @@
 #include "sim/wire/fault_injection.hpp"
 #include "sim/wire/serve_loop.hpp"
 
-namespace hybridctl::sim {
+namespace hybridctl::sim::wire {
 
 /// The kernel has no SocketCAN (AF_CAN); the message says so and names the errno.
 class SocketCanUnavailable : public InputError {
@@ -62,4 +62,4 @@ class SocketCanEndpoint final : public WireEndpoint {
 /// ("socket(PF_CAN, SOCK_RAW, CAN_RAW): Address family not supported by protocol (errno 97)").
 bool socketcan_available(std::string* why = nullptr);
 
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire

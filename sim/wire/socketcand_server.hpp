@@ -40,7 +40,7 @@
 #include "sim/wire/fault_injection.hpp"
 #include "sim/wire/serve_loop.hpp"
 
-namespace hybridctl::sim {
+namespace hybridctl::sim::wire {
 
 struct SocketcandOptions {
   CanNodeOptions node;
@@ -129,4 +129,4 @@ std::size_t split_socketcand_stream(std::string_view in, std::size_t max_element
 /// "< frame ID SEC.USEC DATAHEX >" for a frame received at wall-clock time sec.usec.
 std::string format_socketcand_frame(const protocol::can::CanFrame& frame, long sec, long usec);
 
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire

@@ -210,7 +210,7 @@ TEST_F(Cli, TheSlotsOnTheBAxisMachineAreProvenNotManufacturableAtItsToleranceBef
 // A tube on a plate on the B-axis machine, with a tolerance of one voxel: the bore's edge
 // with the plate is a sharp concave ring whose voxels a cutter's sweep on the grid misses
 // here and there, so the atom kept clear there is one beside it that the 12 mm flat
-// clears (planner/thin_parts.hpp). Milled from the block, each plan executed.
+// clears (planner/atoms/thin_parts.hpp). Milled from the block, each plan executed.
 TEST_F(Cli, TheTubeOnAPlateIsMilledFromTheBlockOnTheBAxisMachineAtAToleranceOfAVoxel) {
   const Outcome r = run({"plan", kParts + "tube-plate.stl", "--machine", kBAxisMachine, "--tolerance", "0.5"});
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;

@@ -17,7 +17,7 @@
 
 #include "geometry/morphology.hpp"
 #include "instruments/elements.hpp"
-#include "planner/machine_primitives.hpp"
+#include "planner/primitives/machine_primitives.hpp"
 #include "sim/instrument.hpp"
 #include "sim/sweep.hpp"
 

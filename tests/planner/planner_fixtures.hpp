@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "geometry/shapes.hpp"
-#include "planner/atoms.hpp"
-#include "planner/search.hpp"
+#include "planner/atoms/atoms.hpp"
+#include "planner/search/search.hpp"
 
 namespace hybridctl::planner::testing {
 

@@ -17,7 +17,7 @@
 #include "config/machine_loader.hpp"
 #include "geometry/mesh.hpp"
 #include "plan/plan_file.hpp"
-#include "planner/plan_report.hpp"
+#include "planner/pipeline/plan_report.hpp"
 #include "geometry/vdb_file.hpp"
 #include "report/report.hpp"
 #include "report/report_as_built.hpp"

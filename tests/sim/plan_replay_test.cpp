@@ -14,7 +14,7 @@
 #include "toolpaths/plan_export.hpp"
 #include "geometry/mesh.hpp"
 #include "geometry/morphology.hpp"
-#include "planner/plan_report.hpp"
+#include "planner/pipeline/plan_report.hpp"
 #include "plan/start_stock.hpp"
 #include "sim/replay.hpp"
 

@@ -427,7 +427,7 @@ TEST(DepositionPath, PassesThePlanDoesNotCountOnAreLeftOutWhereTheNozzleBodyWoul
   // would meet the wall. When an earlier action was to lay the near pad (the plan does not
   // count on this one for it), its passes are left out with a warning; when the plan
   // counts on this action for it, they stay: keeping those clear is the planner's
-  // (planner/deposit_reach.hpp), and the simulated machine stops on them.
+  // (planner/atoms/deposit_reach.hpp), and the simulated machine stops on them.
   const Solid existing = geometry::unite(box({{0, 0, 0}, {30, 10, 1}}), box({{14, 0, 1}, {16, 10, 12}}));
   const Solid far_pad = box({{2, 2, 1}, {6, 8, 2}}), near_pad = box({{17, 2, 1}, {20, 8, 2}});
   const Solid roi = geometry::unite(far_pad, near_pad);

@@ -20,7 +20,7 @@
 #include "toolpaths/setup_frame.hpp"
 #include "geometry/morphology.hpp"
 #include "geometry/shapes.hpp"
-#include "planner/machine_primitives.hpp"
+#include "planner/primitives/machine_primitives.hpp"
 #include "toolpath_oracles.hpp"
 
 namespace hybridctl::toolpaths {

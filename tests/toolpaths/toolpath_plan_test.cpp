@@ -16,7 +16,7 @@
 #include "toolpaths/setup_frame.hpp"
 #include "geometry/morphology.hpp"
 #include "geometry/mesh.hpp"
-#include "planner/planning.hpp"
+#include "planner/pipeline/planning.hpp"
 #include "toolpath_oracles.hpp"
 
 namespace hybridctl::toolpaths {

@@ -14,7 +14,7 @@
 #include "sim/wire/can_node.hpp"
 #include "sim/controller.hpp"
 
-namespace hybridctl::sim {
+namespace hybridctl::sim::wire {
 namespace {
 
 namespace can = protocol::can;
@@ -170,4 +170,4 @@ TEST(CanNode, SendsAStatusSnapshotWhenTheProgramCompletes) {
 }
 
 }  // namespace
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire

@@ -7,7 +7,7 @@
 
 #include "sim/wire/fault_injection.hpp"
 
-namespace hybridctl::sim {
+namespace hybridctl::sim::wire {
 namespace {
 
 std::vector<bool> drops(FaultInjector& f, int events) {
@@ -83,4 +83,4 @@ TEST(FaultInjector, RandomDelaysSpanZeroToTheLimit) {
 }
 
 }  // namespace
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire

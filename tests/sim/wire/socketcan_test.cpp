@@ -27,7 +27,7 @@ namespace can = protocol::can;
 
 TEST(SocketCan, ServesOnAKernelCanInterface) {
   std::string why;
-  if (!sim::socketcan_available(&why)) {
+  if (!sim::wire::socketcan_available(&why)) {
     const PeerResult r = SimProcess::run_to_exit({"--machine", example_machine(), "--socketcan", "vcan0"});
     EXPECT_EQ(r.exit_code, 3) << r.output;
     EXPECT_NE(r.output.find("this kernel has no SocketCAN (AF_CAN)"), std::string::npos) << r.output;

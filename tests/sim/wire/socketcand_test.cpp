@@ -18,8 +18,8 @@
 namespace hybridctl::test {
 namespace {
 
-using sim::parse_socketcand_element;
-using Kind = sim::SocketcandRequest::Kind;
+using sim::wire::parse_socketcand_element;
+using Kind = sim::wire::SocketcandRequest::Kind;
 
 std::map<std::string, std::map<std::string, long>> step_values(const std::string& output) {
   std::map<std::string, std::map<std::string, long>> steps;
@@ -151,7 +151,7 @@ TEST(Socketcand, PacedBusSpreadsASnapshotOverItsFrameTimes) {
     }
   }
   ASSERT_GE(last, 0) << "no whole snapshot";
-  const double expected = 15 * sim::can_frame_time(8, 125000).count() * 1e-6;  // from frame 0's end to frame 15's
+  const double expected = 15 * sim::wire::can_frame_time(8, 125000).count() * 1e-6;  // from frame 0's end to frame 15's
   EXPECT_GE(last - first, 0.8 * expected) << "frames came faster than the bus carries them";
   EXPECT_LT(last - first, 0.05);
   EXPECT_EQ(sim.stop(), 0) << sim.errors();
@@ -191,10 +191,10 @@ TEST(SocketcandText, RefusesMalformedElementsSayingWhy) {
 }
 
 TEST(SocketcandText, SplitsAClientStreamIntoElementsAndWhatIsRefused) {
-  using K = sim::SocketcandPiece::Kind;
+  using K = sim::wire::SocketcandPiece::Kind;
   const std::string in = "  < open can0 >junk <send 123 0 ><unclosed < rawmode >\n< partial";
   std::vector<std::pair<K, std::string>> pieces;
-  const std::size_t used = sim::split_socketcand_stream(in, 256, [&](const sim::SocketcandPiece& p) {
+  const std::size_t used = sim::wire::split_socketcand_stream(in, 256, [&](const sim::wire::SocketcandPiece& p) {
     pieces.emplace_back(p.kind, std::string(p.text));
     return true;
   });
@@ -209,14 +209,14 @@ TEST(SocketcandText, SplitsAClientStreamIntoElementsAndWhatIsRefused) {
   // Too long to be an element: given up on; a false from the callback stops the split.
   const std::string overlong = "<" + std::string(300, 'x');
   pieces.clear();
-  EXPECT_EQ(sim::split_socketcand_stream(overlong, 256, [&](const sim::SocketcandPiece& p) {
+  EXPECT_EQ(sim::wire::split_socketcand_stream(overlong, 256, [&](const sim::wire::SocketcandPiece& p) {
               pieces.emplace_back(p.kind, std::string(p.text));
               return true;
             }),
             overlong.size());
   ASSERT_EQ(pieces.size(), 1u);
   EXPECT_EQ(pieces[0].first, K::Overlong);
-  EXPECT_EQ(sim::split_socketcand_stream("<echo><echo>", 256, [](const sim::SocketcandPiece&) { return false; }), 6u);
+  EXPECT_EQ(sim::wire::split_socketcand_stream("<echo><echo>", 256, [](const sim::wire::SocketcandPiece&) { return false; }), 6u);
 }
 
 TEST(SocketcandText, FormatsFramesAsTheDaemonDoes) {
@@ -226,24 +226,24 @@ TEST(SocketcandText, FormatsFramesAsTheDaemonDoes) {
   f.data[0] = 0x00;
   f.data[1] = 0xAB;
   f.data[2] = 0x5;
-  EXPECT_EQ(sim::format_socketcand_frame(f, 1700000000, 42), "< frame 181 1700000000.000042 00AB05 >");
+  EXPECT_EQ(sim::wire::format_socketcand_frame(f, 1700000000, 42), "< frame 181 1700000000.000042 00AB05 >");
   f.id = 0x12345;
   f.len = 0;
-  EXPECT_EQ(sim::format_socketcand_frame(f, 1, 999999), "< frame 00012345 1.999999  >");
+  EXPECT_EQ(sim::wire::format_socketcand_frame(f, 1, 999999), "< frame 00012345 1.999999  >");
 }
 
 TEST(CanBusTiming, FrameTimesFollowTheBitCount) {
   // 47 framing bits + 8 per byte + worst-case stuffing floor((34 + 8n - 1) / 4).
-  EXPECT_EQ(sim::can_frame_time(8, 1'000'000).count(), 135);  // 111 + 24 bits
-  EXPECT_EQ(sim::can_frame_time(0, 1'000'000).count(), 55);   // 47 + 8 bits
-  EXPECT_EQ(sim::can_frame_time(4, 1'000'000).count(), 95);   // 79 + 16 bits
-  EXPECT_EQ(sim::can_frame_time(8, 500'000).count(), 270);
-  EXPECT_EQ(sim::can_frame_time(8, 0).count(), 0);
-  sim::CanBusClock bus(1'000'000);
-  const sim::CanMicros t0{1000};
+  EXPECT_EQ(sim::wire::can_frame_time(8, 1'000'000).count(), 135);  // 111 + 24 bits
+  EXPECT_EQ(sim::wire::can_frame_time(0, 1'000'000).count(), 55);   // 47 + 8 bits
+  EXPECT_EQ(sim::wire::can_frame_time(4, 1'000'000).count(), 95);   // 79 + 16 bits
+  EXPECT_EQ(sim::wire::can_frame_time(8, 500'000).count(), 270);
+  EXPECT_EQ(sim::wire::can_frame_time(8, 0).count(), 0);
+  sim::wire::CanBusClock bus(1'000'000);
+  const sim::wire::CanMicros t0{1000};
   EXPECT_EQ(bus.reserve(t0, 8).count(), 1135);
   EXPECT_EQ(bus.reserve(t0, 8).count(), 1270) << "a frame waits for the one before it";
-  EXPECT_EQ(bus.reserve(sim::CanMicros{5000}, 0).count(), 5055) << "an idle bus starts at once";
+  EXPECT_EQ(bus.reserve(sim::wire::CanMicros{5000}, 0).count(), 5055) << "an idle bus starts at once";
 }
 
 TEST(Socketcand, RandomTextNeverTakesTheServerDown) {

@@ -1,0 +1,69 @@
+#include "planner/pipeline/candidate_execution.hpp"
+
+#include <map>
+#include <memory>
+#include <optional>
+#include <utility>
+
+#include "plan/start_stock.hpp"
+#include "planner/pipeline/plan_report.hpp"
+
+namespace hybridctl::planner {
+
+plan::PlanFilePlan candidate_plan(const PlanningResult& r, const Plan& plan) {
+  plan::PlanFilePlan out{0, expression(r.problem, plan), plan.cost, {}};
+  for (const PlanStep& step : plan.steps) out.actions.push_back({step.primitive, step.volume, step.cost});
+  return out;
+}
+
+CandidateCheck learn_from_run(const PlanningResult& r, const Plan& plan, const plan::PlanFile& file, plan::CandidateRun run,
+                              std::optional<geometry::Solid>& core) {
+  if (run.proven()) return CandidateCheck{};
+  if (!run.as_built) return CandidateCheck{std::move(run.reasons)};
+  const geometry::Solid& built = *run.as_built;
+  const std::size_t executed = run.executed;
+  std::vector<Shortfall> shortfalls = find_shortfalls(r.problem, r.atoms, plan, executed, built);
+  if (shortfalls.empty() && run.missing_after_last_addition) {
+    if (!core) core = plan::spared_by_cuts(file);
+    shortfalls = find_missing_core_shortfalls(r.problem, r.atoms, plan, executed, geometry::subtract(*core, built));
+  }
+  if (shortfalls.empty()) shortfalls = find_skipped_layer_shortfalls(r.problem, r.atoms, plan, executed, built, run.reasons);
+  if (shortfalls.empty()) shortfalls = find_spills(r.problem, r.atoms, plan, executed, built, run.reasons);
+  return CandidateCheck{std::move(run.reasons), std::move(shortfalls)};
+}
+
+void validate_by_execution(PlanningOptions& options, plan::CandidateExecutor execute, const std::string& machine_name) {
+  struct State {
+    plan::CandidateExecutor execute;
+    std::string machine_name;
+    std::optional<plan::PlanFile> file;    // the planning result's grid, design and primitives
+    std::optional<geometry::Solid> core;   // the design's core (plan::spared_by_cuts), once
+    // Per proven candidate (its primitives in order), each action's cycle time in minutes.
+    std::map<std::vector<int>, std::vector<double>> minutes;
+  };
+  auto state = std::make_shared<State>();
+  state->execute = std::move(execute);
+  state->machine_name = machine_name;
+  options.validate = [state](const PlanningResult& r, const Plan& plan) {
+    if (!state->file) {
+      // No plans yet: only the grid, the design and the primitives are taken.
+      const ReportSources sources{"", "", state->machine_name, ""};
+      state->file = to_plan_file(r, sources, ".");
+    }
+    plan::CandidateRun run = state->execute(*state->file, candidate_plan(r, plan));
+    if (run.proven() && !run.action_minutes.empty()) {
+      std::vector<int> key;
+      for (const PlanStep& s : plan.steps) key.push_back(s.primitive);
+      state->minutes[key] = run.action_minutes;
+    }
+    return learn_from_run(r, plan, *state->file, std::move(run), state->core);
+  };
+  options.toolpath_minutes = [state](const Plan& plan) {
+    std::vector<int> key;
+    for (const PlanStep& s : plan.steps) key.push_back(s.primitive);
+    const auto it = state->minutes.find(key);
+    return it == state->minutes.end() ? std::vector<double>{} : it->second;
+  };
+}
+
+}  // namespace hybridctl::planner
