@@ -244,6 +244,11 @@ class Writer {
       line(deposition_head_->codes.off);
       deposition_head_ = nullptr;
     }
+    stop_milling();
+  }
+
+  // Spindle, then coolant, off where they are on.
+  void stop_milling() {
     if (spindle_on_) {
       line(machine_.gcode.m_codes.spindle_stop);
       spindle_on_ = false;
@@ -321,14 +326,7 @@ class Writer {
         coolant_on_ = true;
       }
     } else {
-      if (spindle_on_) {
-        line(machine_.gcode.m_codes.spindle_stop);
-        spindle_on_ = false;
-      }
-      if (coolant_on_) {
-        line(machine_.gcode.m_codes.coolant_off);
-        coolant_on_ = false;
-      }
+      stop_milling();
       if (in.head->codes.power_template) {
         std::string code = *in.head->codes.power_template;
         code.replace(code.find("{power}"), 7, format_number(in.head->codes.power));

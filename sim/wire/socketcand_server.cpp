@@ -19,7 +19,7 @@
 #include "common/error.hpp"
 #include "sim/controller.hpp"
 
-namespace hybridctl::sim {
+namespace hybridctl::sim::wire {
 
 namespace can = protocol::can;
 
@@ -251,6 +251,19 @@ struct SocketcandServer::Impl {
     }
   }
 
+  // Frames due by `now` queued, then every client's output written; a client whose socket
+  // failed is closed.
+  void pump_and_flush(SteadyTime now) {
+    pump(now);
+    for (std::size_t i = 0; i < clients.size();) {
+      if (!flush(clients[i])) {
+        close_client(i);
+        continue;
+      }
+      ++i;
+    }
+  }
+
   void error(Client& c, const std::string& what) {
     queue_text(c, "< error " + what + " >");
     ++counters.errors_sent;
@@ -276,22 +289,17 @@ struct SocketcandServer::Impl {
         queue_text(c, "< ok >");
         break;
       case K::RawMode:
+      case K::BcmMode: {
+        const bool raw = r.kind == K::RawMode;
         if (c.mode == Mode::NoBus) {
-          error(c, "rawmode before 'open CHANNEL'");
+          error(c, std::string(raw ? "rawmode" : "bcmmode") + " before 'open CHANNEL'");
           return;
         }
-        c.mode = Mode::Raw;
-        c.frames_from = SteadyClock::now() + options.raw_settle;
+        c.mode = raw ? Mode::Raw : Mode::Bcm;
+        if (raw) c.frames_from = SteadyClock::now() + options.raw_settle;
         queue_text(c, "< ok >");
         break;
-      case K::BcmMode:
-        if (c.mode == Mode::NoBus) {
-          error(c, "bcmmode before 'open CHANNEL'");
-          return;
-        }
-        c.mode = Mode::Bcm;
-        queue_text(c, "< ok >");
-        break;
+      }
       case K::Echo:
         queue_text(c, "< echo >");
         break;
@@ -519,26 +527,12 @@ void SocketcandServer::service(std::span<const pollfd> fds, SteadyTime now) {
   }
   if (!fds.empty() && (fds[0].revents & POLLIN)) s.accept_clients();
   // Frames that are due now (all of them without pacing) go at once, not at the next tick.
-  s.pump(now);
-  for (std::size_t i = 0; i < s.clients.size();) {
-    if (!s.flush(s.clients[i])) {
-      s.close_client(i);
-      continue;
-    }
-    ++i;
-  }
+  s.pump_and_flush(now);
 }
 
 void SocketcandServer::tick(SteadyTime now) {
   Impl& s = *impl_;
-  s.pump(now);
-  for (std::size_t i = 0; i < s.clients.size();) {
-    if (!s.flush(s.clients[i])) {
-      s.close_client(i);
-      continue;
-    }
-    ++i;
-  }
+  s.pump_and_flush(now);
 }
 
 SteadyTime SocketcandServer::next_deadline() const {
@@ -549,4 +543,4 @@ SteadyTime SocketcandServer::next_deadline() const {
   return to_steady(t);
 }
 
-}  // namespace hybridctl::sim
+}  // namespace hybridctl::sim::wire
