@@ -42,7 +42,7 @@ bool apply(const PlanningProblem& p, const AtomSet& state, int i, AtomSet& next,
   return true;
 }
 
-double fixed_cost(const PlanningProblem& p, int previous, int next) {
+double fixed_cost_without_refixture(const PlanningProblem& p, int previous, int next) {
   if (previous < 0) return 0;
   const PrimitiveSpec& a = p.primitives[std::size_t(previous)];
   const PrimitiveSpec& b = p.primitives[std::size_t(next)];
@@ -224,7 +224,7 @@ std::vector<Plan> find_plans(const PlanningProblem& p, const SearchOptions& opti
       child.depth = nodes[std::size_t(id)].depth + 1;
       child.step_volume = volume;
       child.step_cost =
-          (p.primitives[std::size_t(i)].cost_per_mm3 * volume + fixed_cost(p, nodes[std::size_t(id)].primitive, i)) /
+          (p.primitives[std::size_t(i)].cost_per_mm3 * volume + fixed_cost_without_refixture(p, nodes[std::size_t(id)].primitive, i)) /
           p.normaliser;
       child.g = nodes[std::size_t(id)].g + child.step_cost;
       child.state = std::move(next);
