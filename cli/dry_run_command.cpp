@@ -32,6 +32,7 @@
 #include "planner/pipeline/candidate_execution.hpp"
 #include "planner/pipeline/plan_report.hpp"
 #include "validation/plan_validator.hpp"
+#include "verification/exact_deviation.hpp"
 
 namespace hybridctl::cli {
 namespace {
@@ -205,10 +206,13 @@ int run_dry_run(const DryRunArgs& a) {
   options.tolerance = a.tolerance;
   options.max_uses = a.reuse;
   options.memory_budget = memory_budget(a.memory_budget);
-  planner::validate_by_execution(options, validation::plan_validator(machine), machine.name);
+  const geometry::TriangleMesh mesh = geometry::read_stl(a.part);
+  validation::ExecutionOptions proving;
+  proving.surfaces = std::make_shared<verification::DesignSurfaces>(mesh, a.part);
+  planner::validate_by_execution(options, validation::plan_validator(machine, std::move(proving)), machine.name);
   options.stock_files = a.stock_files;
   options.objective = objective(a.objective);
-  const planner::PlanningResult planned = planner::plan_part(geometry::read_stl(a.part), a.part, machine, options);
+  const planner::PlanningResult planned = planner::plan_part(mesh, a.part, machine, options);
   const planner::ReportSources sources{a.part, a.machine, machine.name, machine_text};
   std::fputs(planner::plan_summary(planned, sources).c_str(), stdout);
   if (!planned.verdict.manufacturable() || planned.plans.empty()) return kNotManufacturable;

@@ -14,6 +14,7 @@
 #include "planner/pipeline/candidate_execution.hpp"
 #include "planner/pipeline/plan_report.hpp"
 #include "validation/plan_validator.hpp"
+#include "verification/exact_deviation.hpp"
 
 namespace hybridctl::cli {
 namespace {
@@ -65,8 +66,14 @@ int run_plan(const PlanArgs& args) {
   options.search_time = args.search_time;
   for (const std::string& p : args.primitive_files) options.extra_primitives.push_back(parse_primitive_argument(p));
   options.stock_files = args.stock_files;
-  // Every plan offered is proven by execution first (validation/, docs/validation.md).
-  if (!args.no_validate) planner::validate_by_execution(options, validation::plan_validator(machine), machine.name);
+  const geometry::TriangleMesh mesh = geometry::read_stl(args.part);
+  // Every plan offered is proven by execution first (validation/, docs/validation.md), and
+  // the part it makes verified against the STL's real surface (docs/verification.md).
+  if (!args.no_validate) {
+    validation::ExecutionOptions proving;
+    proving.surfaces = std::make_shared<verification::DesignSurfaces>(mesh, args.part);
+    planner::validate_by_execution(options, validation::plan_validator(machine, std::move(proving)), machine.name);
+  }
   options.bands = !args.no_bands;
   options.fine_graining = !args.no_fine_graining;
   options.filled = !args.no_filled;
@@ -82,7 +89,6 @@ int run_plan(const PlanArgs& args) {
     for (const auto& [name, span] : weights)
       if (phase == name) bar.update(span.first + f * (span.second - span.first));
   };
-  const geometry::TriangleMesh mesh = geometry::read_stl(args.part);
   const planner::PlanningResult result = planner::plan_part(mesh, args.part, machine, options);
   bar.finish();
   const planner::ReportSources sources{args.part, args.machine, machine.name, machine_text};

@@ -84,6 +84,19 @@ constexpr double default_standoff(DepositionProcess p) {
   return p == DepositionProcess::WireArc ? 15.0 : 10.0;
 }
 
+/// How close to its programmed surface a process lays material, mm either way, when the
+/// machine file gives none (docs/machine-file.md cites the sources): powder DED 0.25,
+/// laser wire 0.3, DED wire 0.5, wire-arc 1.0 (its waviness).
+constexpr double default_accuracy(DepositionProcess p) {
+  switch (p) {
+    case DepositionProcess::DedPowder: return 0.25;
+    case DepositionProcess::LaserWire: return 0.3;
+    case DepositionProcess::DedWire: return 0.5;
+    case DepositionProcess::WireArc: return 1.0;
+  }
+  return 0.25;
+}
+
 /// What a head's deposit is made of, for what it costs (docs/costs.md).
 struct DepositMaterial {
   double density = 7.9;                 ///< g/cm³ (316L stainless steel); > 0
@@ -141,6 +154,9 @@ struct AdditiveHead {
   double layer_height = 0.0;            ///< mm, 0 < h <= bead.height; default 0.8 x bead.height
   double hatch_spacing = 0.0;           ///< mm, 0 < s <= bead.width; default 0.7 x bead.width
   double travel_clearance = 5.0;        ///< mm lifted for travel moves, >= 0
+  /// mm, > 0: a face left as deposited lies within this of the modelled bead's surface,
+  /// either way (its as-deposited accuracy); default by process (default_accuracy).
+  double accuracy = default_accuracy(DepositionProcess::DedPowder);
   double feed = 1000.0;                 ///< mm/min while depositing
   /// The T number that selects the head (`T.. M6`); default 100 + its index in `heads`;
   /// unique among heads and never a cutting tool's number.

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "geometry/solid.hpp"
+#include "plan/deviation.hpp"
 #include "plan/plan_file.hpp"
 #include "plan/rejection.hpp"
 
@@ -28,6 +29,9 @@ struct CandidateRun {
   // A proven plan: each action's cycle time in minutes as `gcode check` estimates it from
   // the action's own program (0 for one that makes no G-code); empty otherwise.
   std::vector<double> action_minutes;
+  // A proven plan: the part it makes against the design's real surface (none: the design
+  // has no real surface, as a design made on voxels).
+  std::optional<ExactDeviation> exact;
   bool proven() const { return reasons.empty(); }
 };
 

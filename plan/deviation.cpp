@@ -73,4 +73,24 @@ std::string deviation_text(const Deviation& d, double tolerance) {
          (d.within_tolerance ? "within" : "OUTSIDE") + " tolerance (" + shortest_number(tolerance) + " mm)";
 }
 
+namespace {
+
+std::string place_text(const char* what, const ExactPlace& p) {
+  std::string out = std::string(what) + " " + (p.at_least ? "at least " : "") + fixed_number(p.mm, 3) + " mm";
+  if (!p.at) return out;
+  out += " at (" + fixed_number(p.at->x, 2) + ", " + fixed_number(p.at->y, 2) + ", " + fixed_number(p.at->z, 2) + ")";
+  if (p.action > 0) out += " by action " + std::to_string(p.action) + (p.line > 0 ? " (line " + std::to_string(p.line) + ")" : "");
+  else out += " (the start stock)";
+  if (p.as_deposited) out += " as deposited";
+  return out;
+}
+
+}  // namespace
+
+std::string exact_deviation_text(const ExactDeviation& d) {
+  return place_text("excess", d.excess) + ", " + place_text("gouge", d.gouge) + "; " +
+         fixed_number(100 * d.within_share, 1) + " % of the surface within " + shortest_number(d.tolerance) + " mm: " +
+         (d.within_tolerance() ? "within" : "OUTSIDE") + " tolerance";
+}
+
 }  // namespace hybridctl::plan

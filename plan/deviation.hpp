@@ -22,6 +22,7 @@
 // too many or too few is one voxel (h) off both ways. The older fields `worst_over` and
 // `worst_under` keep their meaning, the depth of the wrong voxel's centre, h/2 less.
 
+#include <cstddef>
 #include <optional>
 #include <string>
 
@@ -41,6 +42,33 @@ struct Deviation {
   std::optional<geometry::Vec3> worst_missing_at;  // mm, part frame: the voxel centre where
   bool within_tolerance = false;  // worst_out and worst_missing both at most the tolerance
 };
+
+// The part made measured against the design's real surface, independent of the voxel
+// (verification/exact_deviation.hpp, docs/verification.md): plan.json's `deviation.exact`.
+struct ExactPlace {
+  double mm = 0;                     // how far the part made is from the design's surface there
+  std::optional<geometry::Vec3> at;  // mm, part frame: the point of the part made (none: no deviation)
+  int action = 0;                    // 1-based action whose move left that surface; 0: the start stock
+  int line = 0;                      // its line in the plan's whole program; 0: none
+  bool as_deposited = false;         // a bead's surface, widened by its head's as-deposited accuracy
+  bool at_least = false;             // the deviation reaches the end of the vector: this much or more
+  friend bool operator==(const ExactPlace&, const ExactPlace&) = default;
+};
+
+struct ExactDeviation {
+  ExactPlace excess;          // material beyond the design's surface
+  ExactPlace gouge;           // design material missing under its surface
+  double within_share = 0;    // share of the design's surface area within the tolerance both ways
+  double tolerance = 0;       // mm, the part's
+  double spacing = 0;         // mm between the surface samples
+  std::size_t samples = 0;
+  bool within_tolerance() const { return excess.mm <= tolerance && gouge.mm <= tolerance; }
+  friend bool operator==(const ExactDeviation&, const ExactDeviation&) = default;
+};
+
+// One line for people: "excess 0.24 mm at (x, y, z) by action 2 (line 812), gouge 0.12 mm
+// at ... ; 97.1 % of the surface within 0.5 mm: within tolerance".
+std::string exact_deviation_text(const ExactDeviation& d);
 
 // `made` and `design` on one lattice. Everything outside `made` is air, also beyond
 // `domain` (kept for callers; the distances do not depend on it).

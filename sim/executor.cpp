@@ -237,18 +237,7 @@ LineOutcome ProgramExecutor::execute_line(std::string_view text, int number) {
     if (cutter == i.cutters.end() && bead == i.beads.end()) continue;  // empty spindle
     if (m.is_arc() && m.plane != gcode::Plane::XY) continue;  // the material simulation runs XY arcs only
     i.enter_frame(i.current);
-    const auto& o = i.current->work_origin;
-    auto work = [&](const geometry::Vec3& p) { return geometry::Vec3{p.x - o[0], p.y - o[1], p.z - o[2]}; };
-    MaterialMove move;
-    move.motion = m.kind == gcode::MotionKind::Rapid ? Motion::Rapid
-                  : m.kind == gcode::MotionKind::Feed ? Motion::Linear
-                  : m.kind == gcode::MotionKind::ArcCw ? Motion::ArcCw
-                                                        : Motion::ArcCcw;
-    move.from = work(m.from_machine);
-    move.to = work(m.to_machine);
-    move.centre = work(m.centre_machine);
-    move.process_on = m.deposition;
-    move.line = m.line;
+    const MaterialMove move = material_move(m, *i.current);
     const MoveReport r = cutter != i.cutters.end() ? i.sim->cut(cutter->second, move) : i.sim->deposit(bead->second, move);
     out.incidents.insert(out.incidents.end(), r.incidents.begin(), r.incidents.end());
     // A crash stops the machine once it has happened; a bead that fell does not (the

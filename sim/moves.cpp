@@ -15,6 +15,22 @@ constexpr double kFullCircleSlack = 1e-9;
 
 }  // namespace
 
+MaterialMove material_move(const gcode::Motion& m, const config::Setup& setup) {
+  const auto& o = setup.work_origin;
+  auto work = [&](const geometry::Vec3& p) { return geometry::Vec3{p.x - o[0], p.y - o[1], p.z - o[2]}; };
+  MaterialMove move;
+  move.motion = m.kind == gcode::MotionKind::Rapid  ? Motion::Rapid
+                : m.kind == gcode::MotionKind::Feed ? Motion::Linear
+                : m.kind == gcode::MotionKind::ArcCw ? Motion::ArcCw
+                                                     : Motion::ArcCcw;
+  move.from = work(m.from_machine);
+  move.to = work(m.to_machine);
+  move.centre = work(m.centre_machine);
+  move.process_on = m.deposition;
+  move.line = m.line;
+  return move;
+}
+
 std::vector<Segment> path_segments(const MaterialMove& move, double chord_tolerance) {
   if (!(chord_tolerance > 0)) throw std::invalid_argument("arc chord tolerance must be positive");
   if (move.motion == Motion::Rapid || move.motion == Motion::Linear) return {{move.from, move.to}};

@@ -4,6 +4,8 @@
 
 #include <vector>
 
+#include "config/machine.hpp"
+#include "gcode/interpreter.hpp"
 #include "sim/sweep.hpp"
 
 namespace hybridctl::sim {
@@ -22,6 +24,11 @@ struct MaterialMove {
   bool process_on = false;  // deposition: the head deposits during the move (cutters ignore it)
   int line = 0;             // where the move comes from (G-code line), for incidents
 };
+
+// An interpreted motion as the material simulation replays it in the work frame of
+// `setup` (machine coordinates less the setup's work origin): the one rule the simulated
+// machine and exact verification (verification/) both follow.
+MaterialMove material_move(const gcode::Motion& motion, const config::Setup& setup);
 
 // The straight segments a move is simulated as: the move itself when it is straight. An
 // arc becomes chords no farther than `chord_tolerance` mm from it (sagitta bound on its

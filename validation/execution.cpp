@@ -356,6 +356,27 @@ class IncrementalRun {
   bool right_ = true;  // every action so far went right (a resumed run starts from such a prefix)
 };
 
+// The part a plan that passed on the voxels makes, against the design's real surface: its
+// figures, and a reason for each direction beyond the tolerance.
+void verify_exactly(Execution& out, const plan::PlanFile& file, const plan::PlanFilePlan& plan,
+                    const config::Machine& machine, const ExecutionOptions& options) {
+  verification::DesignSurfaces read_here;
+  verification::DesignSurfaces& surfaces = options.surfaces ? *options.surfaces : read_here;
+  const verification::DesignSurface* surface = surfaces.for_plan(file);
+  if (!surface) return;
+  out.exact = verification::verify_program(*surface, machine, out.program, plan::start_stock(file, plan, machine),
+                                           {file.tolerance});
+  const auto reason = [&](const char* kind, const char* what, const plan::ExactPlace& p) {
+    out.reasons.push_back({kind, p.action, p.line,
+                           std::string("the part made ") + what + " the design's surface by " + (p.at_least ? "at least " : "") +
+                               fixed_number(p.mm, 3) + " mm (exact verification, tolerance " +
+                               shortest_number(file.tolerance) + " mm" + (p.as_deposited ? ", as deposited" : "") + ")",
+                           p.at});
+  };
+  if (out.exact->excess.mm > file.tolerance) reason("exact_excess", "stands out of", out.exact->excess);
+  if (out.exact->gouge.mm > file.tolerance) reason("exact_gouge", "lies inside", out.exact->gouge);
+}
+
 // Exports and executes `plan` with `run`, from `start` when it resumes a prefix.
 Execution run_plan(const plan::PlanFile& file, const plan::PlanFilePlan& plan, const config::Machine& machine,
                    const ExecutionOptions& options, IncrementalRun& run, std::optional<toolpaths::ExportStart> start) {
@@ -384,6 +405,8 @@ Execution run_plan(const plan::PlanFile& file, const plan::PlanFilePlan& plan, c
   out.program = run.finish(out);
   out.deviation = plan::measure_deviation(out.as_built, file.design, file.domain, file.tolerance);
   out.reasons = rejection_reasons(out, file, machine);
+  if (out.reasons.empty() && options.planned_against == PlannedAgainst::MaterialPresent)
+    verify_exactly(out, file, plan, machine, options);
   return out;
 }
 

@@ -27,6 +27,7 @@
 #include "sim/material.hpp"
 #include "toolpaths/plan_export.hpp"
 #include "validation/prefix_cache.hpp"
+#include "verification/exact_deviation.hpp"
 
 namespace hybridctl::validation {
 
@@ -56,6 +57,9 @@ struct ExecutionOptions {
   sim::SimulationOptions simulation;
   PlannedAgainst planned_against = PlannedAgainst::MaterialPresent;
   RunUntil run_until = RunUntil::End;
+  // The design's real surface for exact verification; null: the STL the plan file names,
+  // read when a plan passes on the voxels.
+  std::shared_ptr<verification::DesignSurfaces> surfaces;
 };
 
 struct Execution {
@@ -66,7 +70,10 @@ struct Execution {
   geometry::Solid as_built;            // part frame, the plan's lattice and domain
   sim::SimulationReport report;        // incidents carry the program's lines
   std::vector<std::string> errors;     // lines the machine refused (G-code, envelope, interlocks)
-  plan::Deviation deviation;        // as built against the design
+  plan::Deviation deviation;        // as built against the design, on the voxels
+  // The part made against the design's real surface (verification/): for a plan that
+  // passes on the voxels and ran to its end, when the plan file has a real surface.
+  std::optional<plan::ExactDeviation> exact;
   std::vector<plan::RejectionReason> reasons;  // empty: the plan makes the part
   int stopped_after = 0;  // RunUntil::FirstFailingAction: the action it stopped after (0: ran to the end)
   // Stopped after the plan's last action that adds material, with part of the design's
@@ -98,7 +105,9 @@ Execution execute_plan(const plan::PlanFile& file, const plan::PlanFilePlan& pla
 // The reasons of an execution, as execute_plan fills `reasons`: the toolpaths' defects
 // (layer skipped, region unreachable), every incident kind per action (rapid into
 // material, body collision, gouge, unsupported deposit, ...), refused lines, and the part
-// as built outside the tolerance (missing or excess material).
+// as built outside the tolerance (missing or excess material). A plan that passes all of
+// these is verified exactly against the design's real surface (Execution::exact): beyond
+// the tolerance either way adds an "exact_excess" or "exact_gouge" reason with its place.
 std::vector<plan::RejectionReason> rejection_reasons(const Execution& execution, const plan::PlanFile& file,
                                                         const config::Machine& machine);
 

@@ -75,6 +75,7 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
       plan::CandidateRun out;
       if (run.proven()) {
         if (run.exported.actions.size() == candidate.actions.size()) out.action_minutes = action_minutes(run, machine);
+        out.exact = run.exact;
         return out;
       }
       out.executed = run.stopped_after > 0 ? std::size_t(run.stopped_after) : candidate.actions.size();

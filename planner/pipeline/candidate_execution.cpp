@@ -40,6 +40,7 @@ void validate_by_execution(PlanningOptions& options, plan::CandidateExecutor exe
     std::optional<geometry::Solid> core;   // the design's core (plan::spared_by_cuts), once
     // Per proven candidate (its primitives in order), each action's cycle time in minutes.
     std::map<std::vector<int>, std::vector<double>> minutes;
+    std::map<std::vector<int>, plan::ExactDeviation> exact;  // and its exact deviation
   };
   auto state = std::make_shared<State>();
   state->execute = std::move(execute);
@@ -51,10 +52,11 @@ void validate_by_execution(PlanningOptions& options, plan::CandidateExecutor exe
       state->file = to_plan_file(r, sources, ".");
     }
     plan::CandidateRun run = state->execute(*state->file, candidate_plan(r, plan));
-    if (run.proven() && !run.action_minutes.empty()) {
+    if (run.proven()) {
       std::vector<int> key;
       for (const PlanStep& s : plan.steps) key.push_back(s.primitive);
-      state->minutes[key] = run.action_minutes;
+      if (!run.action_minutes.empty()) state->minutes[key] = run.action_minutes;
+      if (run.exact) state->exact[key] = *run.exact;
     }
     return learn_from_run(r, plan, *state->file, std::move(run), state->core);
   };
@@ -63,6 +65,13 @@ void validate_by_execution(PlanningOptions& options, plan::CandidateExecutor exe
     for (const PlanStep& s : plan.steps) key.push_back(s.primitive);
     const auto it = state->minutes.find(key);
     return it == state->minutes.end() ? std::vector<double>{} : it->second;
+  };
+  options.exact_deviation = [state](const Plan& plan) -> std::optional<plan::ExactDeviation> {
+    std::vector<int> key;
+    for (const PlanStep& s : plan.steps) key.push_back(s.primitive);
+    const auto it = state->exact.find(key);
+    if (it == state->exact.end()) return std::nullopt;
+    return it->second;
   };
 }
 

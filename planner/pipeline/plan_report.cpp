@@ -63,7 +63,30 @@ json class_reasons(bool core, bool thin_feature, bool beyond_hull, bool thin_gap
   return r;
 }
 
-json deviation_json(const plan::Deviation& d) {
+json exact_place_json(const plan::ExactPlace& p) {
+  return {{"mm", p.mm},
+          {"at", place_json(p.at)},
+          {"action", p.action},
+          {"line", p.line},
+          {"as_deposited", p.as_deposited},
+          {"at_least", p.at_least}};
+}
+
+// plan.json's `deviation.exact` (docs/plan-format.md): null when not verified exactly.
+json exact_json(const std::optional<plan::ExactDeviation>& e) {
+  if (!e) return nullptr;
+  return {{"max_excess_mm", e->excess.mm},
+          {"max_gouge_mm", e->gouge.mm},
+          {"excess", exact_place_json(e->excess)},
+          {"gouge", exact_place_json(e->gouge)},
+          {"within_share", e->within_share},
+          {"within_tolerance", e->within_tolerance()},
+          {"tolerance", e->tolerance},
+          {"spacing", e->spacing},
+          {"samples", e->samples}};
+}
+
+json deviation_json(const plan::Deviation& d, const std::optional<plan::ExactDeviation>& exact) {
   return {{"over_volume", d.over_volume},
           {"under_volume", d.under_volume},
           {"worst_over", d.worst_over},
@@ -73,7 +96,8 @@ json deviation_json(const plan::Deviation& d) {
           {"worst_out_at", place_json(d.worst_out_at)},
           {"worst_missing", distance_json(d.worst_missing)},
           {"worst_missing_at", place_json(d.worst_missing_at)},
-          {"within_tolerance", d.within_tolerance}};
+          {"within_tolerance", d.within_tolerance},
+          {"exact", exact_json(exact)}};
 }
 
 // plan.json's `optimality` of the plan at index k (docs/plan-format.md).
@@ -286,7 +310,7 @@ json plans_json(const PlanningResult& r) {
                      {"gap", std::isfinite(plan.gap) ? json(plan.gap) : json(nullptr)},
                      {"file", "plans/plan-" + std::to_string(k + 1) + ".vdb"},
                      {"final_atoms", atom_ids(plan.final_state, r.atoms.atom_count())},
-                     {"deviation", deviation_json(d)},
+                     {"deviation", deviation_json(d, k < r.exact_deviations.size() ? r.exact_deviations[k] : std::nullopt)},
                      {"actions", actions}});
   }
   return plans;
@@ -555,7 +579,9 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
       const json toolpaths = toolpath_total(r, k);
       if (!toolpaths.is_null()) os << "; toolpaths " << duration_text(toolpaths.get<double>());
       os << "\n";
-      os << "     deviation: " << plan::deviation_text(d, r.tolerance) << "\n";
+      os << "     deviation: " << plan::deviation_text(d, r.tolerance) << " (voxels)\n";
+      if (k < r.exact_deviations.size() && r.exact_deviations[k])
+        os << "     exact:     " << plan::exact_deviation_text(*r.exact_deviations[k]) << "\n";
       for (std::size_t s = 0; s < plan.steps.size(); ++s) {
         const PlanStep& st = plan.steps[s];
         const Primitive& p = r.primitives[std::size_t(st.primitive)];

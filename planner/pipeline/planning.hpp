@@ -83,6 +83,9 @@ struct PlanningOptions {
   // toolpaths (validation records them as it proves plans; empty: unknown). Where they
   // are far from the estimate the plans are ranked by them (planner/costing/toolpath_rank.hpp).
   std::function<std::vector<double>(const Plan&)> toolpath_minutes;
+  // After the search: an offered plan's part measured against the design's real surface
+  // (validation records it as it proves plans; none: not verified exactly).
+  std::function<std::optional<plan::ExactDeviation>(const Plan&)> exact_deviation;
   std::int64_t max_rejected = 200;
 };
 
@@ -106,7 +109,10 @@ struct PlanningResult {
   PlanningProblem problem;
   Verdict verdict;
   std::vector<Plan> plans;
-  std::vector<plan::Deviation> deviations;  // one per plan: its outcome against the design
+  std::vector<plan::Deviation> deviations;  // one per plan: its outcome against the design, on the voxels
+  // One per plan: the part its program makes against the design's real surface (none:
+  // planned without validation, or a design without a real surface).
+  std::vector<std::optional<plan::ExactDeviation>> exact_deviations;
   std::vector<RejectedPlan> rejected;  // candidates validation turned down, in the order found
   // What execution showed the primitives do not do (taken out of `problem`'s primitives),
   // in the order learned, how many searches ran (1 + the restarts they caused), and how

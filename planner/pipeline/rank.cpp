@@ -22,6 +22,7 @@ void rank_by_toolpaths(const config::Machine& machine, PlanningResult& r) {
   };
   permute(r.plans);
   permute(r.deviations);
+  permute(r.exact_deviations);
   permute(r.estimates);
   permute(r.toolpath_minutes);
   permute(r.search_rank);

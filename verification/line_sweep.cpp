@@ -1,0 +1,221 @@
+#include "verification/line_sweep.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Core>
+
+namespace hybridctl::verification {
+namespace {
+
+using V3 = Eigen::Vector3d;
+using Kind = sim::ConvexPiece::Kind;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kTiny = 1e-12;
+
+V3 v3(const geometry::Vec3& v) { return {v.x, v.y, v.z}; }
+
+Span all() { return {-kInf, kInf}; }
+Span none() { return {}; }
+Span meet(Span a, Span b) { return {std::max(a.lo, b.lo), std::min(a.hi, b.hi)}; }
+// The smallest interval holding both (the pieces of one convex volume overlap).
+Span hull(Span a, Span b) {
+  if (a.empty()) return b;
+  if (b.empty()) return a;
+  return {std::min(a.lo, b.lo), std::max(a.hi, b.hi)};
+}
+
+// t with a t^2 + b t + c <= 0, for a >= 0.
+Span quadratic_at_most_zero(double a, double b, double c) {
+  if (a <= kTiny) {
+    if (std::abs(b) <= kTiny) return c <= 0 ? all() : none();
+    return b > 0 ? Span{-kInf, -c / b} : Span{-c / b, kInf};
+  }
+  const double disc = b * b - 4 * a * c;
+  if (disc < 0) return none();
+  const double root = std::sqrt(disc);
+  // The stable pair of roots.
+  const double q = -0.5 * (b + (b >= 0 ? root : -root));
+  double r1 = q / a, r2 = std::abs(q) > kTiny ? c / q : r1;
+  if (r1 > r2) std::swap(r1, r2);
+  return {r1, r2};
+}
+
+// t with lo <= p + t d <= hi (one coordinate).
+Span slab(double p, double d, double lo, double hi) {
+  if (std::abs(d) <= kTiny) return p >= lo && p <= hi ? all() : none();
+  double a = (lo - p) / d, b = (hi - p) / d;
+  if (a > b) std::swap(a, b);
+  return {a, b};
+}
+
+Span ball(const V3& p, const V3& d, const V3& c, double r) {
+  const V3 w = p - c;
+  return quadratic_at_most_zero(d.dot(d), 2 * d.dot(w), w.dot(w) - r * r);
+}
+
+// The capsule of radius r around segment e0-e1 (a ball when they coincide).
+Span capsule(const V3& p, const V3& d, const V3& e0, const V3& e1, double r) {
+  Span s = hull(ball(p, d, e0, r), ball(p, d, e1, r));
+  const V3 axis = e1 - e0;
+  const double length = axis.norm();
+  if (length <= kTiny) return s;
+  const V3 u = axis / length;
+  const V3 w = p - e0;
+  const V3 wp = w - w.dot(u) * u, dp = d - d.dot(u) * u;
+  const Span tube = quadratic_at_most_zero(dp.dot(dp), 2 * dp.dot(wp), wp.dot(wp) - r * r);
+  return hull(s, meet(tube, slab(w.dot(u), d.dot(u), 0, length)));
+}
+
+// A capsule in XY (z ignored) against the line's XY projection.
+Span capsule_xy(const V3& p, const V3& d, const V3& a, const V3& b, double r) {
+  const V3 p2(p.x(), p.y(), 0), d2(d.x(), d.y(), 0), a2(a.x(), a.y(), 0), b2(b.x(), b.y(), 0);
+  return capsule(p2, d2, a2, b2, r);
+}
+
+// Distance in XY from q to the segment a-b.
+double distance_xy(const V3& q, const V3& a, const V3& b) {
+  const double ux = b.x() - a.x(), uy = b.y() - a.y();
+  const double wx = q.x() - a.x(), wy = q.y() - a.y();
+  const double uu = ux * ux + uy * uy;
+  const double s = uu > kTiny ? std::clamp((wx * ux + wy * uy) / uu, 0.0, 1.0) : 0.0;
+  return std::hypot(wx - s * ux, wy - s * uy);
+}
+
+// The piece's convex gauge at v (relative to its programmed point): <= 0 inside.
+double gauge(const sim::ConvexPiece& piece, const V3& v) {
+  const double slab_term = std::max(piece.from - v.z(), v.z() - piece.to);
+  const double radial = std::hypot(v.x(), v.y());
+  double shape = 0;
+  switch (piece.kind) {
+    case Kind::Cylinder: shape = radial - piece.radius; break;
+    case Kind::Sphere: shape = std::hypot(radial, v.z() - piece.centre) - piece.radius; break;
+    case Kind::Ellipsoid:
+      shape = std::hypot(radial, (v.z() - piece.centre) * piece.radius / piece.half_height) - piece.radius;
+      break;
+    case Kind::Torus: shape = std::hypot(std::max(0.0, radial - piece.ring), v.z() - piece.centre) - piece.radius; break;
+  }
+  return std::max(shape, slab_term);
+}
+
+// Minimum of a convex function on [a, b] by golden-section search: where it is.
+template <class F>
+double argmin_convex(F f, double a, double b, int iterations) {
+  constexpr double r = 0.6180339887498949;
+  double x1 = b - r * (b - a), x2 = a + r * (b - a);
+  double f1 = f(x1), f2 = f(x2);
+  for (int i = 0; i < iterations && b - a > 1e-13; ++i) {
+    if (f1 <= f2) {
+      b = x2, x2 = x1, f2 = f1;
+      x1 = b - r * (b - a), f1 = f(x1);
+    } else {
+      a = x1, x1 = x2, f1 = f2;
+      x2 = a + r * (b - a), f2 = f(x2);
+    }
+  }
+  return f1 <= f2 ? x1 : x2;
+}
+
+// {t in [t0, t1] : g(t) <= 0} for a convex g: one interval.
+template <class G>
+Span sublevel(G g, double t0, double t1) {
+  const double tm = argmin_convex(g, t0, t1, 90);
+  if (g(tm) > 0) return none();
+  auto edge = [&](double outside, double inside) {
+    if (g(outside) <= 0) return outside;
+    for (int i = 0; i < 60 && std::abs(inside - outside) > 1e-10; ++i) {
+      const double mid = 0.5 * (inside + outside);
+      (g(mid) <= 0 ? inside : outside) = mid;
+    }
+    return inside;
+  };
+  return {edge(t0, tm), edge(t1, tm)};
+}
+
+bool whole_in_slab(const sim::ConvexPiece& piece, double half_height) {
+  return piece.from <= piece.centre - half_height + 1e-12 && piece.to >= piece.centre + half_height - 1e-12;
+}
+
+}  // namespace
+
+Span line_in_sweep(const sim::ConvexPiece& piece, const sim::Segment& segment, const geometry::Vec3& p_in,
+                   const geometry::Vec3& d_in, double t0, double t1) {
+  const V3 p = v3(p_in), d = v3(d_in), a = v3(segment.from), b = v3(segment.to);
+  const V3 move = b - a;
+  const bool level = std::abs(move.z()) <= kTiny;
+  const bool vertical = std::abs(move.x()) <= kTiny && std::abs(move.y()) <= kTiny;
+  const Span range{t0, t1};
+  switch (piece.kind) {
+    case Kind::Cylinder:
+      if (level)
+        return meet(range, meet(slab(p.z(), d.z(), a.z() + piece.from, a.z() + piece.to),
+                                capsule_xy(p, d, a, b, piece.radius)));
+      if (vertical)
+        return meet(range, meet(slab(p.z(), d.z(), std::min(a.z(), b.z()) + piece.from, std::max(a.z(), b.z()) + piece.to),
+                                capsule_xy(p, d, a, a, piece.radius)));
+      break;
+    case Kind::Sphere:
+      if (whole_in_slab(piece, piece.radius)) {
+        const V3 up(0, 0, piece.centre);
+        return meet(range, capsule(p, d, a + up, b + up, piece.radius));
+      }
+      break;
+    case Kind::Ellipsoid:
+      if (whole_in_slab(piece, piece.half_height)) {
+        // Scaling Z by radius / half_height turns the ellipsoid into a ball.
+        const double k = piece.radius / piece.half_height;
+        const V3 scale(1, 1, k), up(0, 0, piece.centre);
+        return meet(range, capsule(p.cwiseProduct(scale), d.cwiseProduct(scale), (a + up).cwiseProduct(scale),
+                                   (b + up).cwiseProduct(scale), piece.radius));
+      }
+      break;
+    case Kind::Torus:
+      if (level && whole_in_slab(piece, piece.radius)) {
+        const V3 a2(a.x(), a.y(), 0), b2(b.x(), b.y(), 0);
+        const double zc = a.z() + piece.centre;
+        return sublevel(
+            [&](double t) {
+              const V3 q = p + t * d;
+              return std::hypot(std::max(0.0, distance_xy(q, a2, b2) - piece.ring), q.z() - zc) - piece.radius;
+            },
+            t0, t1);
+      }
+      if (vertical && whole_in_slab(piece, piece.radius)) {
+        const double z0 = std::min(a.z(), b.z()) + piece.centre, z1 = std::max(a.z(), b.z()) + piece.centre;
+        return sublevel(
+            [&](double t) {
+              const V3 q = p + t * d;
+              const double dz = q.z() < z0 ? z0 - q.z() : q.z() > z1 ? q.z() - z1 : 0.0;
+              return std::hypot(std::max(0.0, std::hypot(q.x() - a.x(), q.y() - a.y()) - piece.ring), dz) - piece.radius;
+            },
+            t0, t1);
+      }
+      break;
+  }
+  // Any other case: the general convex sublevel set, minimising over the segment inside.
+  return sublevel(
+      [&](double t) {
+        const V3 q = p + t * d;
+        return gauge(piece, q - (a + move * argmin_convex([&](double s) { return gauge(piece, q - (a + s * move)); },
+                                                          0.0, 1.0, 70)));
+      },
+      t0, t1);
+}
+
+std::vector<sim::ConvexPiece> completed_pieces(std::span<const sim::ConvexPiece> pieces) {
+  std::vector<sim::ConvexPiece> out(pieces.begin(), pieces.end());
+  for (sim::ConvexPiece& p : out) {
+    if (p.kind != Kind::Sphere && p.kind != Kind::Torus) continue;
+    if (p.to < p.centre - 1e-12 || p.to >= p.centre + p.radius) continue;
+    const bool continued = std::any_of(out.begin(), out.end(), [&](const sim::ConvexPiece& c) {
+      return c.kind == Kind::Cylinder && std::abs(c.radius - p.reach()) <= 1e-12 && c.from <= p.centre + 1e-12 &&
+             c.to >= p.centre + p.radius - 1e-12;
+    });
+    if (continued) p.to = p.centre + p.radius;
+  }
+  return out;
+}
+
+}  // namespace hybridctl::verification
