@@ -18,6 +18,10 @@ namespace hybridctl::plan {
 using config::Mode;
 using config::PrimitiveKind;
 
+// The copy of the part's STL a plan directory holds beside plan.json, so that the design's
+// real surface travels with the plan (exact verification, docs/verification.md).
+inline constexpr const char* kDesignStl = "design.stl";
+
 // plan.json's `version`: what this reader reads and the writer writes.
 inline constexpr int kPlanFormatVersion = 1;
 

@@ -405,7 +405,7 @@ Execution run_plan(const plan::PlanFile& file, const plan::PlanFilePlan& plan, c
   out.program = run.finish(out);
   out.deviation = plan::measure_deviation(out.as_built, file.design, file.domain, file.tolerance);
   out.reasons = rejection_reasons(out, file, machine);
-  if (out.reasons.empty() && options.planned_against == PlannedAgainst::MaterialPresent)
+  if (out.reasons.empty() && options.verify_exactly && options.planned_against == PlannedAgainst::MaterialPresent)
     verify_exactly(out, file, plan, machine, options);
   return out;
 }

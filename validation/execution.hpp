@@ -60,6 +60,8 @@ struct ExecutionOptions {
   // The design's real surface for exact verification; null: the STL the plan file names,
   // read when a plan passes on the voxels.
   std::shared_ptr<verification::DesignSurfaces> surfaces;
+  // Off: the voxels alone (bench/exact_verification_bench compares the two).
+  bool verify_exactly = true;
 };
 
 struct Execution {

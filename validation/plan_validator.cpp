@@ -6,11 +6,15 @@
 #include <optional>
 
 #include "common/error.hpp"
+#include "common/number_text.hpp"
 #include "gcode/check.hpp"
 #include "gcode/post.hpp"
 
 namespace hybridctl::validation {
 namespace {
+
+// Candidates beyond the tolerance against the STL before the rest are not verified.
+constexpr int kExactFailuresBeforeGivingUp = 8;
 
 // Minutes per action of an execution that ran to its end: each action's own program under
 // the time model of `gcode check`.
@@ -45,6 +49,13 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
     std::vector<FailedPrefix> failed_prefixes;
     // ... and the same holds for the prefixes that went right: candidates go on from there.
     std::shared_ptr<PrefixCache> cache;
+    // Exact verification: candidates that made the part on the voxels but not against the
+    // STL, and whether any made it against the STL. Its failures come from how faces are
+    // cut and laid, which the search's next candidates mostly share; past a few, the rest
+    // are turned down unexecuted rather than verified one by one.
+    int exact_failures = 0;
+    bool exact_passed = false;
+    double closest_mm = 0;
   };
   // A candidate is rejected at its first failing action: its first reasons are enough.
   options.run_until = RunUntil::FirstFailingAction;
@@ -65,8 +76,29 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
         known.reasons = failed.reasons;
         return known;
       }
+    if (!state->exact_passed && state->exact_failures >= kExactFailuresBeforeGivingUp) {
+      plan::CandidateRun skipped;
+      skipped.reasons = {{"not_verified", 0, 0,
+                          "not executed: the " + std::to_string(state->exact_failures) +
+                              " cheaper candidates that made the part on the voxels all left it beyond the tolerance "
+                              "against the STL (the closest by " + fixed_number(state->closest_mm, 3) +
+                              " mm): faces need finishing passes, or a looser tolerance (docs/verification.md)",
+                          std::nullopt}};
+      return skipped;
+    }
     try {
       Execution run = execute_plan(file, candidate, machine, state->options, state->cache.get());
+      if (run.exact) {
+        if (run.exact->within_tolerance()) {
+          state->exact_passed = true;
+        } else if (run.proven() || std::all_of(run.reasons.begin(), run.reasons.end(), [](const plan::RejectionReason& r) {
+                     return r.kind == "exact_excess" || r.kind == "exact_gouge";
+                   })) {
+          const double off = std::max(run.exact->excess.mm, run.exact->gouge.mm);
+          state->closest_mm = state->exact_failures == 0 ? off : std::min(state->closest_mm, off);
+          ++state->exact_failures;
+        }
+      }
       if (run.stopped_after > 0) {
         std::vector<int> prefix;
         for (int k = 0; k < run.stopped_after; ++k) prefix.push_back(candidate.actions[std::size_t(k)].primitive);

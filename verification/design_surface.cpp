@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <mutex>
 #include <vector>
@@ -31,12 +32,16 @@ using AabbTree = CGAL::AABB_tree<CGAL::AABB_traits<K, Primitive>>;
 Point point(const Vec3& v) { return {v.x, v.y, v.z}; }
 Vec3 vec(const Vector& v) { return {v.x(), v.y(), v.z()}; }
 
-// The longest-edge bisection of a triangle until no edge is longer than twice `spacing`:
-// each leaf's centroid is a sample standing for the leaf's area (about spacing^2 on a
-// large face; a facet smaller than that is one sample).
+// The longest-edge bisection of a triangle until no edge is longer than twice `spacing`
+// or the piece is smaller than half a spacing square: each leaf's centroid is a sample
+// standing for the leaf's area (about spacing^2 on a large face; a facet smaller than
+// that is one sample).
 void sample_triangle(const Triangle3& t, const Vector& normal, double spacing, std::vector<SurfaceSample>& out) {
   std::vector<Triangle3> stack{t};
   const double limit = 4 * spacing * spacing;
+  // A piece already smaller than half a spacing square is not split on: the slivers of a
+  // fan of long thin facets (a cylinder's cap) would otherwise multiply without need.
+  const double sliver = std::pow(spacing * spacing / 2, 2);
   while (!stack.empty()) {
     const Triangle3 f = stack.back();
     stack.pop_back();
@@ -46,7 +51,7 @@ void sample_triangle(const Triangle3& t, const Vector& normal, double spacing, s
       const double l = CGAL::squared_distance(f[i], f[(i + 1) % 3]);
       if (l > longest) longest = l, edge = i;
     }
-    if (longest <= limit) {
+    if (longest <= limit || f.squared_area() <= sliver) {
       const Point c = CGAL::centroid(f);
       out.push_back({{c.x(), c.y(), c.z()}, vec(normal), 0, 0, std::sqrt(f.squared_area())});
       continue;
@@ -119,12 +124,17 @@ DesignSurface::DesignSurface(const geometry::TriangleMesh& mesh, const std::stri
     SurfaceSample& s = samples_[i];
     const Vector n(s.normal.x, s.normal.y, s.normal.z);
     auto free_length = [&](const Vector& dir) {
-      const auto hit = tree.first_intersection(K::Ray_3(point(s.point) + start * dir, dir));
-      if (!hit) return options_.reach;
-      const Point* at = boost::get<Point>(&hit->first);
-      const K::Segment_3* along = boost::get<K::Segment_3>(&hit->first);
-      const double to = std::sqrt(CGAL::squared_distance(point(s.point), at ? *at : along->source()));
-      return std::min(options_.reach, 0.5 * to);
+      // Only faces within twice the reach matter: a segment query prunes the tree to them.
+      const K::Segment_3 probe(point(s.point) + start * dir, point(s.point) + 2 * options_.reach * dir);
+      std::vector<AabbTree::Intersection_and_primitive_id<K::Segment_3>::Type> hits;
+      tree.all_intersections(probe, std::back_inserter(hits));
+      double nearest = 2 * options_.reach;
+      for (const auto& hit : hits) {
+        const Point* at = boost::get<Point>(&hit.first);
+        const K::Segment_3* along = boost::get<K::Segment_3>(&hit.first);
+        nearest = std::min(nearest, std::sqrt(CGAL::squared_distance(point(s.point), at ? *at : along->source())));
+      }
+      return std::min(options_.reach, 0.5 * nearest);
     };
     s.outward = free_length(n);
     s.inward = free_length(-n);

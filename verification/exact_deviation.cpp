@@ -214,7 +214,9 @@ class Verifier {
         if (!gouge.at) gouge.at = s.point, gouge.action = surface_op->action, gouge.line = surface_op->line;
       }
       if (excess.mm <= tolerance && gouge.mm <= tolerance) within += s.area;
-      if (excess.at && (!out.excess.at || excess.mm > out.excess.mm)) out.excess = excess;
+      if (excess.at && (!out.excess.at || excess.mm > out.excess.mm)) {
+        out.excess = excess;
+      }
       if (gouge.at && (!out.gouge.at || gouge.mm > out.gouge.mm)) out.gouge = gouge;
     }
     out.within_share = total > 0 ? within / total : 1.0;
@@ -291,9 +293,14 @@ const DesignSurface* DesignSurfaces::for_plan(const plan::PlanFile& file) {
   const double voxel = file.lattice.voxel_size;
   if (surface_ && tolerance_ == file.tolerance && voxel_ == voxel) return surface_.get();
   if (!mesh_) {
-    if (file.part.empty()) return nullptr;
     std::filesystem::path path(file.part);
     if (path.is_relative() && !file.directory.empty()) path = file.directory / path;
+    std::error_code ec;
+    // The copy the plan directory holds, wherever it was copied to; else the part it names.
+    if (!file.directory.empty() && std::filesystem::is_regular_file(file.directory / plan::kDesignStl, ec))
+      path = file.directory / plan::kDesignStl;
+    else if (file.part.empty())
+      return nullptr;
     name_ = path.string();
     mesh_ = geometry::read_stl(path);
   }

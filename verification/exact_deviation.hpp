@@ -53,9 +53,10 @@ class DesignSurfaces {
  public:
   DesignSurfaces() = default;
   DesignSurfaces(geometry::TriangleMesh mesh, std::string name);
-  // Null when there is no real surface to verify against: no mesh was given and the plan
-  // file names no part (a design made on voxels, as tests make them). Throws InputError
-  // naming the STL when the plan file names one that cannot be read.
+  // Null when there is no real surface to verify against: no mesh was given, the plan
+  // directory holds no design.stl and the plan file names no part (a design made on
+  // voxels, as tests make them). Throws InputError naming the STL when the one found
+  // cannot be read.
   const DesignSurface* for_plan(const plan::PlanFile& file);
 
  private:

@@ -466,6 +466,10 @@ void write_plan_directory(const PlanningResult& r, const ReportSources& src, con
                             "plan-" + std::to_string(k + 1));
       }
     });
+    // The design's real surface goes with the plan: exact verification (export, run,
+    // dry-run) reads it wherever the directory is copied to.
+    if (!src.part_path.empty() && fs::is_regular_file(src.part_path, ec))
+      fs::copy_file(src.part_path, staging / plan::kDesignStl);
     std::ofstream out(staging / "plan.json");
     out << plan_json(r, src, dir);
     if (!out.flush()) throw InputError((staging / "plan.json").string() + ": cannot write");

@@ -1,0 +1,77 @@
+// What exact verification (verification/, docs/verification.md) adds to validating a plan:
+// each bundled part is planned once (every plan proven), then every offered plan is
+// executed again from the raw stock on the voxels alone and with exact verification, in
+// the same process, one after the other. Counters: seconds per plan both ways and the
+// ratio of what exact verification adds to the voxel validation (aim: at most 1).
+//
+//   BUILD_TARGET=exact_verification_bench scripts/build -DHYBRIDCTL_BUILD_BENCH=ON
+//   build/bench/exact_verification_bench
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <memory>
+#include <string>
+
+#include "config/machine_loader.hpp"
+#include "geometry/mesh.hpp"
+#include "planner/pipeline/candidate_execution.hpp"
+#include "planner/pipeline/plan_report.hpp"
+#include "planner/pipeline/planning.hpp"
+#include "validation/execution.hpp"
+#include "validation/plan_validator.hpp"
+#include "verification/exact_deviation.hpp"
+
+namespace {
+
+using namespace hybridctl;
+
+double seconds_of(auto&& fn) {
+  const auto t0 = std::chrono::steady_clock::now();
+  fn();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void exact_against_voxels(benchmark::State& state, const std::string& part, const std::string& machine_file) {
+  const std::string root = HYBRIDCTL_SOURCE_DIR "/";
+  const config::Machine machine = config::load_machine(root + machine_file);
+  const geometry::TriangleMesh mesh = geometry::read_stl(root + part);
+  planner::PlanningOptions options;
+  validation::ExecutionOptions proving;
+  proving.surfaces = std::make_shared<verification::DesignSurfaces>(mesh, part);
+  planner::validate_by_execution(options, validation::plan_validator(machine, proving), machine.name);
+  const planner::PlanningResult planned = planner::plan_part(mesh, part, machine, options);
+  const plan::PlanFile file = planner::to_plan_file(planned, {part, machine_file, machine.name, ""}, ".");
+  double voxels = 0, exact = 0;
+  for (auto _ : state) {
+    for (const plan::PlanFilePlan& p : file.plans) {
+      validation::ExecutionOptions alone;
+      alone.verify_exactly = false;
+      voxels += seconds_of([&] { benchmark::DoNotOptimize(validation::execute_plan(file, p, machine, alone)); });
+      validation::ExecutionOptions with;
+      with.surfaces = std::make_shared<verification::DesignSurfaces>(mesh, part);
+      exact += seconds_of([&] { benchmark::DoNotOptimize(validation::execute_plan(file, p, machine, with)); });
+    }
+  }
+  const double plans = double(file.plans.size()) * double(state.iterations());
+  state.counters["plans"] = double(file.plans.size());
+  state.counters["voxels_s_per_plan"] = voxels / plans;
+  state.counters["exact_s_per_plan"] = exact / plans;
+  state.counters["added_ratio"] = voxels > 0 ? (exact - voxels) / voxels : 0;
+}
+
+BENCHMARK_CAPTURE(exact_against_voxels, flanged_hub, "examples/parts/flanged-hub.stl",
+                  "examples/machines/hybrid-3axis.yaml")
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(exact_against_voxels, tube_plate, "examples/parts/tube-plate.stl",
+                  "examples/machines/multitask-b-axis.yaml")
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
+BENCHMARK_CAPTURE(exact_against_voxels, boss_plate, "examples/parts/boss-plate.stl",
+                  "examples/machines/wire-ded-ti.yaml")
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
