@@ -150,7 +150,7 @@ void add_plan_command(CLI::App& app, Runner& runner) {
   cmd->add_option("--voxel", args->voxel, "Voxel size in mm (default: the machine file's planning.voxel_size)")
       ->check(greater_than(0));
   add_memory_budget_option(cmd, args->memory_budget);
-  cmd->add_option("--tolerance", args->tolerance, "Tolerance in mm (default: the machine file's planning.tolerance)")
+  cmd->add_option("--tolerance", args->tolerance, "Tolerance in mm on the STL's real surface, both ways: every plan offered makes a part within it by exact verification (default: the machine file's planning.tolerance)")
       ->check(at_least(0));
   cmd->add_option("--top", args->top, "How many plans (default: the machine file's planning.top_k)")
       ->check(greater_than(0));

@@ -14,7 +14,7 @@ namespace hybridctl::validation {
 namespace {
 
 // Candidates beyond the tolerance against the STL before the rest are not verified.
-constexpr int kExactFailuresBeforeGivingUp = 8;
+constexpr int kExactFailuresBeforeGivingUp = 3;
 
 // Minutes per action of an execution that ran to its end: each action's own program under
 // the time model of `gcode check`.

@@ -192,16 +192,18 @@ class Verifier {
         const Vec3 at = along(s, top.hi);
         excess = place(surface_.distance(at), at, top.hi_op, top.hi >= s.outward - 1e-9);
       }
-      // The deepest air under the surface: the vector's inner end when no material reaches
-      // it, else the top of the first run when that lies under the surface.
+      // How deep the part made's surface lies under the design's: the top of the material
+      // under the surface when it ends below it, or the vector's inner end when there is
+      // none. A void enclosed deeper in (the modelled beads' thin slivers between layers at
+      // a deposit's fringe) is not the surface; the voxels judge voids.
       double deepest = 1;
       int deepest_op = 0;
-      if (runs.empty() || runs.front().lo > -s.inward + 1e-9) {
+      if (!under) {
         deepest = -s.inward;
         deepest_op = runs.empty() ? 0 : runs.front().lo_op;
-      } else if (runs.front().hi < -1e-9) {
-        deepest = runs.front().hi;
-        deepest_op = runs.front().hi_op;
+      } else if (under->hi < -1e-9) {
+        deepest = under->hi;
+        deepest_op = under->hi_op;
       }
       if (deepest < 0) {
         const Vec3 at = along(s, deepest);
@@ -214,9 +216,7 @@ class Verifier {
         if (!gouge.at) gouge.at = s.point, gouge.action = surface_op->action, gouge.line = surface_op->line;
       }
       if (excess.mm <= tolerance && gouge.mm <= tolerance) within += s.area;
-      if (excess.at && (!out.excess.at || excess.mm > out.excess.mm)) {
-        out.excess = excess;
-      }
+      if (excess.at && (!out.excess.at || excess.mm > out.excess.mm)) out.excess = excess;
       if (gouge.at && (!out.gouge.at || gouge.mm > out.gouge.mm)) out.gouge = gouge;
     }
     out.within_share = total > 0 ? within / total : 1.0;

@@ -118,14 +118,24 @@ double argmin_convex(F f, double a, double b, int iterations) {
   return f1 <= f2 ? x1 : x2;
 }
 
-// {t in [t0, t1] : g(t) <= 0} for a convex g: one interval.
+// {t in [t0, t1] : g(t) <= 0} for a convex g: one interval. A coarse scan brackets the
+// minimum first, which also keeps a g that is only piecewise convex from misleading the
+// search.
 template <class G>
 Span sublevel(G g, double t0, double t1) {
-  const double tm = argmin_convex(g, t0, t1, 90);
+  constexpr int kScan = 16;
+  int best = 0;
+  double lowest = g(t0);
+  for (int k = 1; k <= kScan; ++k) {
+    const double v = g(t0 + (t1 - t0) * k / kScan);
+    if (v < lowest) lowest = v, best = k;
+  }
+  const double step = (t1 - t0) / kScan;
+  const double tm = argmin_convex(g, std::max(t0, t0 + (best - 1) * step), std::min(t1, t0 + (best + 1) * step), 32);
   if (g(tm) > 0) return none();
   auto edge = [&](double outside, double inside) {
     if (g(outside) <= 0) return outside;
-    for (int i = 0; i < 60 && std::abs(inside - outside) > 1e-10; ++i) {
+    for (int i = 0; i < 34 && std::abs(inside - outside) > 1e-9; ++i) {
       const double mid = 0.5 * (inside + outside);
       (g(mid) <= 0 ? inside : outside) = mid;
     }
@@ -144,9 +154,11 @@ Span line_in_sweep(const sim::ConvexPiece& piece, const sim::Segment& segment, c
                    const geometry::Vec3& d_in, double t0, double t1) {
   const V3 p = v3(p_in), d = v3(d_in), a = v3(segment.from), b = v3(segment.to);
   const V3 move = b - a;
-  const bool level = std::abs(move.z()) <= kTiny;
-  const bool vertical = std::abs(move.x()) <= kTiny && std::abs(move.y()) <= kTiny;
-  const Span range{t0, t1};
+  // Within a nanometre of level or of vertical is taken as such (frames and origins leave
+  // rounding in the last digits).
+  const bool level = std::abs(move.z()) <= 1e-9;
+  const bool vertical = std::abs(move.x()) <= 1e-9 && std::abs(move.y()) <= 1e-9;
+  Span range{t0, t1};
   switch (piece.kind) {
     case Kind::Cylinder:
       if (level)
@@ -175,6 +187,11 @@ Span line_in_sweep(const sim::ConvexPiece& piece, const sim::Segment& segment, c
       if (level && whole_in_slab(piece, piece.radius)) {
         const V3 a2(a.x(), a.y(), 0), b2(b.x(), b.y(), 0);
         const double zc = a.z() + piece.centre;
+        // Within the prism around it (its slab, the capsule of its reach) first.
+        range = meet(range, meet(slab(p.z(), d.z(), zc - piece.radius, zc + piece.radius),
+                                 capsule_xy(p, d, a, b, piece.reach())));
+        if (range.empty()) return none();
+        t0 = range.lo, t1 = range.hi;
         return sublevel(
             [&](double t) {
               const V3 q = p + t * d;
@@ -184,6 +201,10 @@ Span line_in_sweep(const sim::ConvexPiece& piece, const sim::Segment& segment, c
       }
       if (vertical && whole_in_slab(piece, piece.radius)) {
         const double z0 = std::min(a.z(), b.z()) + piece.centre, z1 = std::max(a.z(), b.z()) + piece.centre;
+        range = meet(range, meet(slab(p.z(), d.z(), z0 - piece.radius, z1 + piece.radius),
+                                 capsule_xy(p, d, a, a, piece.reach())));
+        if (range.empty()) return none();
+        t0 = range.lo, t1 = range.hi;
         return sublevel(
             [&](double t) {
               const V3 q = p + t * d;
@@ -194,12 +215,36 @@ Span line_in_sweep(const sim::ConvexPiece& piece, const sim::Segment& segment, c
       }
       break;
   }
-  // Any other case: the general convex sublevel set, minimising over the segment inside.
+  if (piece.kind == Kind::Cylinder) {
+    // On a ramp: the positions whose slab holds the point's height are an interval of the
+    // segment, in closed form, and the nearest of them in XY too.
+    const double zmin = std::min(a.z(), b.z()), zmax = std::max(a.z(), b.z());
+    return sublevel(
+        [&](double t) {
+          const V3 q = p + t * d;
+          // Heights of the programmed point for which the slab holds q: [q.z - to, q.z - from].
+          const double h0 = std::clamp(q.z() - piece.to, zmin, zmax), h1 = std::clamp(q.z() - piece.from, zmin, zmax);
+          const double out_of_slab = std::max({0.0, zmin + piece.from - q.z(), q.z() - (zmax + piece.to)});
+          // Those positions in XY: the sub-segment between the heights h0 and h1.
+          const V3 e0 = a + move * ((h0 - a.z()) / move.z()), e1 = a + move * ((h1 - a.z()) / move.z());
+          return std::max(out_of_slab, distance_xy(q, e0, e1) - piece.radius);
+        },
+        t0, t1);
+  }
+  // Any other case: the general convex sublevel set, minimising over the segment inside,
+  // searched only where the ball around the piece's slab meets the line.
+  if (std::isfinite(piece.to)) {
+    const double half = 0.5 * (piece.to - piece.from);
+    const V3 mid(0, 0, piece.from + half);
+    range = meet(range, capsule(p, d, a + mid, b + mid, std::hypot(piece.reach(), half)));
+    if (range.empty()) return none();
+    t0 = range.lo, t1 = range.hi;
+  }
   return sublevel(
       [&](double t) {
         const V3 q = p + t * d;
         return gauge(piece, q - (a + move * argmin_convex([&](double s) { return gauge(piece, q - (a + s * move)); },
-                                                          0.0, 1.0, 70)));
+                                                          0.0, 1.0, 28)));
       },
       t0, t1);
 }

@@ -68,7 +68,7 @@ TEST_F(Export, TheFlangedHubDepositedThenMilledIsAValidatedPlanThatExports) {
   const std::string machine = (kSource / "examples/machines/hybrid-3axis.yaml").string();
   const fs::path plan = dir_ / "plan";
   const Outcome planned = hybridctl({"plan", (kSource / "examples/parts/flanged-hub.stl").string(), "--machine", machine,
-                                     "--voxel", "0.5", "--top", "10", "-o", plan.string()});
+                                     "--voxel", "0.5", "--tolerance", "1.0", "--top", "10", "-o", plan.string()});
   ASSERT_EQ(planned.exit_code, 0) << planned.out << planned.err;
   const std::size_t at = planned.out.find(". (P6 \u2212 P9)  cost");
   ASSERT_NE(at, std::string::npos) << planned.out;
@@ -80,7 +80,7 @@ TEST_F(Export, TheFlangedHubDepositedThenMilledIsAValidatedPlanThatExports) {
   const fs::path out = dir_ / "out";
   const Outcome exported = hybridctl({"export", plan.string(), "--plan", rank.substr(rank.find_first_not_of(' ')), "-o", out.string()});
   ASSERT_EQ(exported.exit_code, 0) << exported.out << exported.err;
-  EXPECT_NE(exported.out.find("(tolerance 0.50 mm, within)"), std::string::npos) << exported.out;
+  EXPECT_NE(exported.out.find("(tolerance 1.00 mm, within)"), std::string::npos) << exported.out;
   const std::string name = "plan-" + rank.substr(rank.find_first_not_of(' ')) + ".ngc";
   const std::string program = slurp(out / name);
   EXPECT_NE(program.find("M64 P0"), std::string::npos);
