@@ -231,6 +231,19 @@ Span line_in_sweep(const sim::ConvexPiece& piece, const sim::Segment& segment, c
         },
         t0, t1);
   }
+  if (piece.kind == Kind::Torus) {
+    // On a ramp: first the cylinder of its reach over its height, which holds it (closed
+    // form above), so that a line that misses costs no search and one that meets it is
+    // searched over that span only.
+    sim::ConvexPiece hull;
+    hull.kind = Kind::Cylinder;
+    hull.radius = piece.reach();
+    hull.from = piece.centre - piece.radius;
+    hull.to = piece.centre + piece.radius;
+    range = meet(range, line_in_sweep(hull, segment, p_in, d_in, t0, t1));
+    if (range.empty()) return none();
+    t0 = range.lo, t1 = range.hi;
+  }
   // Any other case: the general convex sublevel set, minimising over the segment inside,
   // searched only where the ball around the piece's slab meets the line.
   if (std::isfinite(piece.to)) {
