@@ -139,7 +139,9 @@ INSTANTIATE_TEST_SUITE_P(Examples, ExamplePartVolume,
                                            ExamplePart{"flanged-hub.stl"}, ExamplePart{"flanged-hub-worn.stl"},
                                            ExamplePart{"channel-block.stl"}, ExamplePart{"arch-channel-block.stl"},
                                            ExamplePart{"boss-plate.stl"}, ExamplePart{"tube-plate.stl"},
-                                           ExamplePart{"leaning-wall.stl"}),
+                                           ExamplePart{"leaning-wall.stl"}, ExamplePart{"lidded-channel-block.stl"},
+                                           ExamplePart{"bladed-disc.stl"}, ExamplePart{"gusset-bracket.stl"},
+                                           ExamplePart{"rounded-box-dimple.stl"}),
                          [](const auto& info) {
                            std::string name = info.param.file;
                            name = name.substr(0, name.find('.'));
