@@ -184,10 +184,10 @@ bool dry_run_plan(const DryRunArgs& a, const plan::PlanFile& file, int rank, con
   const geometry::Solid built = geometry::read_vdb(as_built);
   const geometry::Solid built_here = copied_onto(built, file.lattice, file.domain);
   const geometry::Solid extra = subtract(built_here, planned_shape), missing = subtract(planned_shape, built_here);
-  const plan::Deviation d = plan::measure_deviation(built_here, file.design, file.domain, file.tolerance);
+  const plan::Deviation d = plan::measure_deviation(built_here, file.design, file.domain, file.band());
   std::printf("as built    %.1f mm³ (planned %.1f mm³): %.1f mm³ beyond the plan, %.1f mm³ of it missing\n",
               built_here.volume(), planned_shape.volume(), extra.volume(), missing.volume());
-  std::printf("vs design   %s\n", plan::deviation_text(d, file.tolerance).c_str());
+  std::printf("vs design   %s\n", plan::deviation_text(d, file.band()).c_str());
   std::printf("wrote       %s: job/, as-built.vdb, sim-report.json, executed-lines.ngc\n", out.c_str());
   return d.within_tolerance && alarms.empty();
 }

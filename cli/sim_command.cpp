@@ -103,7 +103,7 @@ void add_sim_command(CLI::App& app, Runner& runner) {
       ->check(between(0.0, 65.0));
   auto* stock_plan = serve_cmd->add_option("--stock", r->stock_plan,
                                            "Stock from a plan (plan.json or its directory): the plan's raw stock; the "
-                                           "design shrunk by the tolerance is protected");
+                                           "design shrunk by the planning band is protected");
   auto* stock_vdb = serve_cmd->add_option("--stock-vdb", r->stock_vdb, "Stock from a .vdb file")->check(CLI::ExistingFile);
   stock_plan->excludes(stock_vdb);
   add_memory_budget_option(serve_cmd, *memory_budget_text);

@@ -121,6 +121,18 @@ void require_closed(const MeshReport& report, const std::string& name) {
                    "the mesh in CAD and export it again");
 }
 
+std::vector<Triangle> axis_square_faces(const TriangleMesh& mesh) {
+  const bool inverted = signed_volume(mesh) < 0;
+  std::vector<Triangle> out;
+  for (const Triangle& t : mesh.triangles) {
+    const bool square = (t[0].x == t[1].x && t[1].x == t[2].x) || (t[0].y == t[1].y && t[1].y == t[2].y) ||
+                        (t[0].z == t[1].z && t[1].z == t[2].z);
+    if (!square) continue;
+    out.push_back(inverted ? Triangle{t[0], t[2], t[1]} : t);
+  }
+  return out;
+}
+
 double signed_volume(const TriangleMesh& mesh) {
   // Relative to the first vertex, to keep the determinants small and well-conditioned.
   if (mesh.triangles.empty()) return 0;

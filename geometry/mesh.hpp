@@ -18,6 +18,7 @@ using Triangle = std::array<Vec3, 3>;
 
 struct TriangleMesh {
   std::vector<Triangle> triangles;
+  friend bool operator==(const TriangleMesh&, const TriangleMesh&) = default;
 };
 
 enum class StlFormat { Binary, Ascii };
@@ -52,5 +53,10 @@ void require_closed(const MeshReport& report, const std::string& name);
 // Volume by signed tetrahedra; positive for an outward-oriented closed mesh.
 double signed_volume(const TriangleMesh& mesh);
 Box3 bounds(const TriangleMesh& mesh);
+
+// The facets that lie square to an axis (their three vertices share one coordinate), wound
+// so that their normals point out of the solid whatever the mesh's winding: the flat faces
+// a setup's floors and walls are made to exactly (toolpaths/pocket_path.hpp).
+std::vector<Triangle> axis_square_faces(const TriangleMesh& mesh);
 
 }  // namespace hybridctl::geometry

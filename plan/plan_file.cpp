@@ -199,6 +199,19 @@ void read_rejected(const Node& rejected, PlanFile& f) {
   }
 }
 
+// The copy the plan directory holds, wherever it was copied to; else the part it names;
+// else none (a design made on voxels). One that is there but unreadable is an error.
+geometry::TriangleMesh design_mesh_of(const PlanFile& f) {
+  std::error_code ec;
+  const fs::path copy = f.directory / kDesignStl;
+  if (fs::is_regular_file(copy, ec)) return geometry::read_stl(copy);
+  if (f.part.empty()) return {};
+  fs::path part(f.part);
+  if (part.is_relative()) part = f.directory / part;
+  if (fs::is_regular_file(part, ec)) return geometry::read_stl(part);
+  return {};
+}
+
 }  // namespace
 
 PlanFile parse_plan_file(std::string_view json_text, const fs::path& json_path) {
@@ -213,6 +226,7 @@ PlanFile parse_plan_file(std::string_view json_text, const fs::path& json_path) 
   read_grid(top.at("grid"), f.lattice, f.domain);
   f.tolerance = top.at("tolerance").number();
   f.design = load_region(f.directory, top.at("design").at("file"), f.lattice, f.domain);
+  f.design_mesh = design_mesh_of(f);
 
   const Node prims = top.at("primitives");
   for (std::size_t i = 0; i < prims.size(); ++i) {

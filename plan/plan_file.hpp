@@ -10,7 +10,9 @@
 #include <vector>
 
 #include "config/primitive_kind.hpp"
+#include "geometry/mesh.hpp"
 #include "geometry/solid.hpp"
+#include "plan/planning_band.hpp"
 #include "plan/rejection.hpp"
 
 namespace hybridctl::plan {
@@ -71,8 +73,13 @@ struct PlanFile {
 
   geometry::Lattice lattice;
   geometry::IndexBox domain;
-  double tolerance = 0;
+  double tolerance = 0;  // mm, the part's, on the design's real surface (plan/planning_band.hpp)
+  double band() const { return planning_band(tolerance, lattice.voxel_size); }  // mm, on the voxels
   geometry::Solid design;
+  // The design's real surface: the plan directory's design.stl, else the part's STL it
+  // names; empty for a design made on voxels (tests) or when neither file is there. Exact
+  // verification measures against it and milling cuts to its flat faces.
+  geometry::TriangleMesh design_mesh;
   std::vector<PlanFilePrimitive> primitives;
   std::vector<PlanFilePlan> plans;
   std::vector<PlanFileRejected> rejected;  // empty in older plans and when nothing was rejected

@@ -45,7 +45,7 @@ geometry::Solid start_stock(const PlanFile& file, const PlanFilePlan& plan, cons
 geometry::Solid spared_by_cuts(const PlanFile& file, const PlanFilePrimitive* action) {
   const bool removal = action && action->mode == Mode::Subtractive;
   const geometry::Solid kept = removal ? subtract(file.design, action->region) : file.design;
-  return geometry::erode(kept, geometry::Ball{file.tolerance});
+  return geometry::erode(kept, geometry::Ball{file.band()});
 }
 
 }  // namespace hybridctl::plan

@@ -29,6 +29,9 @@ struct MeshBudget {
   std::size_t violating_atom = 4000;  // each violating atom
   std::size_t state = 8000;           // each plan's solid after each action
   std::size_t as_built = 20000;       // as built and each deviation band
+  // The design's own STL, painted with each plan's exact deviation: sent as it is, never
+  // coarsened (it is the surface measured); an STL with more triangles gets no map.
+  std::size_t design_stl = 200000;
 };
 
 // The page's size budget: refused (nothing written) beyond it, so a report always mails.
@@ -46,6 +49,10 @@ struct ReportRequest {
   MeshBudget budget;
   std::size_t size_budget = kDefaultSizeBudget;  // bytes
   bool snapshots = true;             // PNGs beside the page
+  // Plans (the best first) whose programs are replayed as validation runs them and measured
+  // against the STL's real surface, for the exact deviation on the design's own mesh
+  // (report_exact.hpp); 0: none.
+  std::size_t exact_plans = 64;
 };
 
 struct ReportResult {

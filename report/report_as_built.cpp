@@ -17,7 +17,7 @@ AsBuilt as_built(const plan::PlanFile& file, const std::filesystem::path& as_bui
   const geometry::Solid over = subtract(out.built, file.design), under = subtract(file.design, out.built);
   // Within the tolerance as plan::measure_deviation counts it: voxel centres at most the
   // tolerance plus half a voxel apart (the distance to the surface between the voxels).
-  const geometry::Ball band{file.tolerance + file.lattice.voxel_size / 2};
+  const geometry::Ball band{file.band() + file.lattice.voxel_size / 2};
   out.over_beyond = subtract(over, geometry::dilate(file.design, band, file.domain));
   out.over_within = subtract(over, out.over_beyond);
   out.under_beyond = intersect(under, geometry::erode(file.design, band));

@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 
 #include "common/error.hpp"
 #include "common/hash.hpp"
@@ -90,10 +91,11 @@ class Gatherer {
     doc["voxel_size"] = file_.lattice.voxel_size;
     doc["domain_mm"] = box_json(file_.lattice.extent(file_.domain));
     doc["budget"] = budget_json();
+    data_.tolerance = file_.tolerance;
     design();
     primitives();
     atoms_and_verdict();
-    plans();
+    plans_and_exact();
     doc["rejected"] = field(raw_, "rejected", json::array());
     if (!request_.as_built.empty()) as_built_section();
     mesh_all();
@@ -107,7 +109,7 @@ class Gatherer {
     const MeshBudget& b = request_.budget;
     return {{"design", b.design},   {"primitive", b.primitive}, {"atom_class", b.atom_class},
             {"violating_atom", b.violating_atom}, {"state", b.state}, {"as_built", b.as_built},
-            {"page_bytes", request_.size_budget}};
+            {"design_stl", b.design_stl}, {"page_bytes", request_.size_budget}};
   }
 
   // A placeholder for a solid's mesh, filled in by mesh_all(). Plans share states (the
@@ -250,12 +252,38 @@ class Gatherer {
       }
       entry["actions"] = actions;
       entry["cycle_s"] = cycle;
-      data_.plans.push_back(PlanView{{}, paths.actions});
+      data_.plans.push_back(PlanView{{}, paths.actions, std::nullopt});
       out.push_back(std::move(entry));
     }
     data_.document["plans"] = out;
   }
 
+  // The plans' states and toolpaths, and beside them, in another task (on the bundled
+  // parts they take about as long), each plan's exact deviation on the design's mesh.
+  void plans_and_exact() {
+    std::optional<ExactMaps> exact;
+    std::string error;
+    tbb::task_group side;
+    const bool measure = request_.exact_plans > 0 && !file_.plans.empty();
+    if (measure)
+      side.run([&] {
+        try {
+          exact = exact_maps(file_, machine_, request_.exact_plans, request_.budget.design_stl);
+        } catch (const std::exception& e) {
+          error = e.what();
+        }
+      });
+    try {
+      plans();
+    } catch (...) {
+      side.wait();
+      throw;
+    }
+    side.wait();
+    if (measure) exact_section(exact, error);
+  }
+
+  void exact_section(const std::optional<ExactMaps>& exact, const std::string& error);
   void as_built_section();
 
   const ReportRequest& request_;
@@ -275,6 +303,70 @@ class Gatherer {
   std::vector<std::size_t> violating_jobs_;
   std::vector<std::vector<std::size_t>> state_jobs_;  // per plan, per action
 };
+
+json exact_place_json(const plan::ExactPlace& p) {
+  return {{"mm", p.mm},
+          {"at", p.at ? json::array({p.at->x, p.at->y, p.at->z}) : json(nullptr)},
+          {"action", p.action},
+          {"line", p.line},
+          {"as_deposited", p.as_deposited},
+          {"at_least", p.at_least}};
+}
+
+// The shape of plan.json's deviation.exact (docs/plan-format.md).
+json exact_summary_json(const plan::ExactDeviation& e) {
+  return {{"max_excess_mm", e.excess.mm},   {"max_gouge_mm", e.gouge.mm},
+          {"excess", exact_place_json(e.excess)}, {"gouge", exact_place_json(e.gouge)},
+          {"within_share", e.within_share}, {"within_tolerance", e.within_tolerance()},
+          {"tolerance", e.tolerance},       {"spacing", e.spacing},
+          {"samples", e.samples}};
+}
+
+// One plan's figures per triangle of design.surface (docs/report.md, "Data").
+json exact_map_json(const TriangleDeviations& d) {
+  if (!d.error.empty()) return {{"error", d.error}};
+  const double tolerance = d.summary.tolerance;
+  std::size_t beyond = 0, deposited = 0;
+  for (std::size_t t = 0; t < d.excess.size(); ++t) {
+    if (d.excess[t] > tolerance || d.gouge[t] > tolerance) ++beyond;
+    deposited += d.deposited[t];
+  }
+  return {{"summary", exact_summary_json(d.summary)},
+          {"triangles", d.excess.size()},
+          {"beyond_triangles", beyond},
+          {"deposited_triangles", deposited},
+          {"excess", base64(d.excess.data(), d.excess.size() * sizeof(float))},
+          {"gouge", base64(d.gouge.data(), d.gouge.size() * sizeof(float))},
+          {"action", base64(d.action.data(), d.action.size() * sizeof(std::uint16_t))},
+          {"deposited", base64(d.deposited.data(), d.deposited.size())}};
+}
+
+void Gatherer::exact_section(const std::optional<ExactMaps>& exact, const std::string& error) {
+  json& surface = data_.document["design"]["surface"];
+  if (!error.empty()) {
+    surface = {{"error", error}};
+    return;
+  }
+  if (!exact) {
+    surface = {{"error", "no STL: the design was given as voxels, so there is no real surface to measure the plans against"}};
+    return;
+  }
+  const std::size_t triangles = exact->design.triangles();
+  surface = {{"file", exact->stl}, {"triangles", triangles}};
+  if (triangles > request_.budget.design_stl) {
+    surface["error"] = "the STL has " + std::to_string(triangles) + " triangles, over the report's budget of " +
+                       std::to_string(request_.budget.design_stl) + " for it: no exact deviation map";
+    return;
+  }
+  surface["mesh"] = mesh_json(exact->design);
+  data_.triangles += triangles;
+  data_.design_stl = exact->design;
+  json& plans = data_.document["plans"];
+  for (std::size_t k = 0; k < exact->plans.size() && k < plans.size(); ++k) {
+    plans[k]["exact_map"] = exact_map_json(exact->plans[k]);
+    if (exact->plans[k].error.empty()) data_.plans[k].exact = exact->plans[k];
+  }
+}
 
 void Gatherer::as_built_section() {
   const AsBuilt built = as_built(file_, request_.as_built);

@@ -5,9 +5,11 @@
 // per-plan gap, deviation places) are passed through when present, never required.
 
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <vector>
 
 #include "report/report.hpp"
+#include "report/report_exact.hpp"
 #include "report/report_mesh.hpp"
 #include "report/report_toolpaths.hpp"
 
@@ -17,11 +19,14 @@ namespace hybridctl::report {
 struct PlanView {
   std::vector<IndexedMesh> states;  // the solid after each action
   std::vector<ActionPath> paths;    // each action's toolpath (empty when it has none)
+  std::optional<TriangleDeviations> exact;  // per triangle of ReportData::design_stl; none: not measured
 };
 
 struct ReportData {
   nlohmann::json document;
   IndexedMesh design;
+  IndexedMesh design_stl;  // the design's own STL, as exact verification samples it (empty: none)
+  double tolerance = 0;    // mm, the part's
   std::vector<IndexedMesh> violating;  // each violating atom
   std::vector<PlanView> plans;
   std::size_t triangles = 0, segments = 0;

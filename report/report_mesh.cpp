@@ -48,7 +48,9 @@ struct VertexHash {
   }
 };
 
-IndexedMesh indexed(const geometry::TriangleMesh& mesh, double voxel_size) {
+}  // namespace
+
+IndexedMesh indexed_mesh(const geometry::TriangleMesh& mesh, double voxel_size) {
   IndexedMesh out;
   out.voxel_size = voxel_size;
   std::unordered_map<VertexKey, std::uint32_t, VertexHash> index;
@@ -63,6 +65,8 @@ IndexedMesh indexed(const geometry::TriangleMesh& mesh, double voxel_size) {
     }
   return out;
 }
+
+namespace {
 
 // Flat regions merge into larger polygons; the voxel staircase on slopes stays.
 constexpr double kAdaptivity = 0.5;
@@ -110,7 +114,7 @@ IndexedMesh budget_mesh(const Solid& solid, std::size_t triangle_budget) {
     const Solid meshed = coarsen(solid, factor);
     geometry::TriangleMesh mesh = geometry::surface_mesh(meshed, kAdaptivity, geometry::SurfaceMethod::Occupancy);
     if (mesh.triangles.size() <= triangle_budget || factor >= kMaxCoarsening || meshed.empty())
-      return indexed(mesh, meshed.voxel_size());
+      return indexed_mesh(mesh, meshed.voxel_size());
     // Triangles shrink with the square of the voxel size.
     const double ratio = std::sqrt(double(mesh.triangles.size()) / budget);
     factor = std::min(kMaxCoarsening, std::max(factor + 1, int(std::ceil(factor * ratio * 1.05))));

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "geometry/mesh.hpp"
 #include "geometry/solid.hpp"
 
 namespace hybridctl::report {
@@ -29,6 +30,10 @@ geometry::Solid coarsen(const geometry::Solid& solid, int factor);
 // budget is exceeded rather than the shape lost). Adjacent flat faces are merged
 // (OpenVDB's adaptivity).
 IndexedMesh budget_mesh(const geometry::Solid& solid, std::size_t triangle_budget);
+
+// A triangle mesh as it is (no meshing, no budget: the design's own STL), its vertices
+// shared where they are equal, its triangles in the same order.
+IndexedMesh indexed_mesh(const geometry::TriangleMesh& mesh, double voxel_size = 0);
 
 // Base64 of raw little-endian bytes (what the page decodes into typed arrays).
 std::string base64(const void* data, std::size_t bytes);

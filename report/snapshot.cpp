@@ -106,7 +106,8 @@ void draw_mesh(Canvas& canvas, const Camera& camera, const SnapshotMesh& m, std:
     // Lit from above and behind the viewer; faces turned away are lit as if turned to it.
     const float shade = float(0.42 + 0.58 * std::abs(dot(n, light)));
     const float facing = float(0.85 + 0.15 * std::abs(dot(n, camera.forward())));
-    const Colour c{m.colour[0] * shade * facing, m.colour[1] * shade * facing, m.colour[2] * shade * facing};
+    const Colour& base = m.triangle_colours && t / 3 < m.triangle_colours->size() ? (*m.triangle_colours)[t / 3] : m.colour;
+    const Colour c{base[0] * shade * facing, base[1] * shade * facing, base[2] * shade * facing};
     fill_triangle(canvas, screen, c, layer);
   }
 }
@@ -120,13 +121,16 @@ void draw_lines(Canvas& canvas, const Camera& camera, const SnapshotLines& lines
     const Colour& c = lines.colours[std::min(s, lines.colours.size() - 1)];
     for (int i = 0; i <= steps; ++i) {
       const double t = double(i) / steps;
-      const int x = int(a.x + (b.x - a.x) * t), y = int(a.y + (b.y - a.y) * t);
-      if (x < 0 || y < 0 || x >= canvas.width || y >= canvas.height) continue;
-      const std::size_t k = std::size_t(y) * canvas.width + x;
+      const int x0 = int(a.x + (b.x - a.x) * t) - (lines.width - 1) / 2, y0 = int(a.y + (b.y - a.y) * t) - (lines.width - 1) / 2;
       const float z = float(a.z + (b.z - a.z) * t) - 0.5f;  // lines on a surface stay in front of it
-      if (z >= canvas.depth[k]) continue;
-      canvas.depth[k] = z;
-      canvas.colour[k] = c;
+      for (int y = y0; y < y0 + lines.width; ++y)
+        for (int x = x0; x < x0 + lines.width; ++x) {
+          if (x < 0 || y < 0 || x >= canvas.width || y >= canvas.height) continue;
+          const std::size_t k = std::size_t(y) * canvas.width + x;
+          if (z >= canvas.depth[k]) continue;
+          canvas.depth[k] = z;
+          canvas.colour[k] = c;
+        }
     }
   }
 }

@@ -19,11 +19,13 @@ struct SnapshotMesh {
   const IndexedMesh* mesh = nullptr;
   Colour colour{0.7f, 0.7f, 0.7f};
   bool x_ray = false;  // drawn over everything else, 70 % opaque: what must be seen even inside
+  const std::vector<Colour>* triangle_colours = nullptr;  // one per triangle, instead of `colour`
 };
 
 struct SnapshotLines {
   const std::vector<float>* points = nullptr;  // two vertices (x, y, z) per segment
   std::vector<Colour> colours;                 // one per segment
+  int width = 1;                               // pixels of the supersampled canvas (2 per pixel of the image)
 };
 
 struct SnapshotTile {

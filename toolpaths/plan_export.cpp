@@ -1,6 +1,8 @@
 #include "toolpaths/plan_export.hpp"
 
 #include <algorithm>
+#include <map>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 
@@ -11,6 +13,49 @@
 
 namespace hybridctl::toolpaths {
 namespace {
+
+// The design's flat faces a tool in this setup cuts down to: those whose outward normal
+// points at the tool, in the setup's work frame (their three vertices at one height).
+std::vector<geometry::Triangle> floors_facing(const std::vector<geometry::Triangle>& faces, config::Approach approach) {
+  const geometry::Vec3 towards = approach_vector(approach);
+  std::vector<geometry::Triangle> out;
+  for (const geometry::Triangle& t : faces) {
+    const geometry::Vec3 u{t[1].x - t[0].x, t[1].y - t[0].y, t[1].z - t[0].z};
+    const geometry::Vec3 v{t[2].x - t[0].x, t[2].y - t[0].y, t[2].z - t[0].z};
+    const geometry::Vec3 n{u.y * v.z - u.z * v.y, u.z * v.x - u.x * v.z, u.x * v.y - u.y * v.x};
+    if (n.x * towards.x + n.y * towards.y + n.z * towards.z <= 0) continue;
+    geometry::Triangle w{part_to_work(t[0], approach), part_to_work(t[1], approach), part_to_work(t[2], approach)};
+    if (w[0].z != w[1].z || w[1].z != w[2].z) continue;  // square to another axis
+    out.push_back(w);
+  }
+  return out;
+}
+
+// The design's STL in each setup's work frame, cleaned (geometry::clean_mesh: wall finishing
+// counts facets even-odd, as the voxelizer does) and turned once per approach: shared by
+// every milling action of an export rather than copied per action.
+class DesignFrames {
+ public:
+  explicit DesignFrames(const geometry::TriangleMesh& mesh) : mesh_(mesh) {}
+  std::shared_ptr<const std::vector<geometry::Triangle>> in(config::Approach approach) {
+    if (mesh_.triangles.empty()) return nullptr;
+    auto& slot = frames_[approach];
+    if (!slot) {
+      if (!cleaned_) cleaned_ = geometry::clean_mesh(mesh_);
+      auto turned = std::make_shared<std::vector<geometry::Triangle>>();
+      turned->reserve(cleaned_->triangles.size());
+      for (const geometry::Triangle& t : cleaned_->triangles)
+        turned->push_back({part_to_work(t[0], approach), part_to_work(t[1], approach), part_to_work(t[2], approach)});
+      slot = std::move(turned);
+    }
+    return slot;
+  }
+
+ private:
+  const geometry::TriangleMesh& mesh_;
+  std::optional<geometry::TriangleMesh> cleaned_;
+  std::map<config::Approach, std::shared_ptr<const std::vector<geometry::Triangle>>> frames_;
+};
 
 const config::Setup& setup_named(const config::Machine& m, const plan::PlanFilePrimitive& p) {
   for (const auto& s : m.setups)
@@ -28,10 +73,11 @@ double plate_z(const plan::PlanFile& file, const geometry::IndexBox& simulated, 
 }
 
 // The action's toolpath from its region of influence in the material it meets.
-// `counted_on`: DepositionOptions::counted_on, or null.
+// `counted_on`: DepositionOptions::counted_on, or null. `design`: the design's STL a
+// removal finishes its walls on, or null for one that cuts into the design on purpose.
 void make_program(const plan::PlanFile& file, const geometry::IndexBox& simulated, const plan::PlanFilePrimitive& p,
                   const config::Machine& machine, const ExportOptions& options, ExportedAction& a,
-                  const geometry::Solid* counted_on) {
+                  const geometry::Solid* counted_on, DesignFrames* design) {
   const config::Setup& setup = setup_named(machine, p);
   ActionProgram& prog = a.program;
   prog.action = a.step;
@@ -58,7 +104,13 @@ void make_program(const plan::PlanFile& file, const geometry::IndexBox& simulate
   } else {
     const config::CuttingTool* tool = machine.find_tool(p.tool_number);
     if (!tool) throw InputError(p.name + " (" + p.label + "): the machine has no tool T" + std::to_string(p.tool_number));
-    prog.path = pocket_path(a.roi, a.after, a.before, *tool, setup, options.pocket);
+    PocketOptions pocket = options.pocket;
+    pocket.floors = floors_facing(geometry::axis_square_faces(file.design_mesh), setup.approach);
+    if (design) {
+      pocket.design = design->in(setup.approach);
+      pocket.design_voxels = &file.design;
+    }
+    prog.path = pocket_path(a.roi, a.after, a.before, *tool, setup, pocket);
   }
   // A path with no move makes no G-code: its block would only approach the path's
   // (meaningless) start. Why stays in the note, its defects in the program.
@@ -100,7 +152,7 @@ void check_machine(const plan::PlanFile& file, const config::Machine& machine) {
 // tells the part of a deposit's ROI the plan counts on it for (DepositionOptions::counted_on).
 ExportedAction make_action(int k, geometry::Solid before, const geometry::Solid* after, const geometry::IndexBox& simulated,
                            const plan::PlanFile& file, const plan::PlanFilePlan& plan,
-                           const config::Machine& machine, const ExportOptions& options,
+                           const config::Machine& machine, const ExportOptions& options, DesignFrames& design,
                            const geometry::Solid* planned_before = nullptr) {
   const plan::PlanFilePrimitive& p = file.primitives.at(std::size_t(plan.actions.at(std::size_t(k)).primitive));
   const bool additive = p.mode == config::Mode::Additive;
@@ -122,7 +174,20 @@ ExportedAction make_action(int k, geometry::Solid before, const geometry::Solid*
     // what its primitive adds to the planned state before it.
     const std::optional<geometry::Solid> counted_on =
         additive && planned_before ? std::optional(subtract(a.roi, *planned_before)) : std::nullopt;
-    make_program(file, simulated, p, machine, options, a, counted_on ? &*counted_on : nullptr);
+    // A removal that takes design material a later deposit lays again cuts past the
+    // design's walls on purpose (SM-cons: mill past the design, then deposit): its walls
+    // are not finished. Design voxels it takes that nothing lays again (the plan may drop
+    // them within its band) are the design's to keep: wall finishing keeps them.
+    bool cuts_design = false;
+    if (!additive) {
+      const geometry::Solid cut = intersect(a.roi, file.design);
+      for (std::size_t j = std::size_t(k) + 1; j < plan.actions.size() && !cut.empty() && !cuts_design; ++j) {
+        const plan::PlanFilePrimitive& later = file.primitives.at(std::size_t(plan.actions[j].primitive));
+        cuts_design = later.mode == config::Mode::Additive && !intersect(cut, later.region).empty();
+      }
+    }
+    make_program(file, simulated, p, machine, options, a, counted_on ? &*counted_on : nullptr,
+                 cuts_design ? nullptr : &design);
   }
   return a;
 }
@@ -134,15 +199,16 @@ void export_from(int first, geometry::Solid present, const std::vector<geometry:
                  const ExportOptions& options, const MaterialAfter& material_after, PlanExport& out) {
   const int n = int(plan.actions.size());
   const geometry::IndexBox simulated = plan::simulated_domain(file, plan, machine);
+  DesignFrames design(file.design_mesh);
   for (int k = first; k < n; ++k) {
     if (options.progress) options.progress(k + 1, n);
     const plan::PlanFilePrimitive& p = file.primitives[std::size_t(plan.actions[std::size_t(k)].primitive)];
     if (p.raw_stock()) out.raw_stock = p.label;
     const geometry::Solid* planned_before = planned.empty() ? nullptr : &planned[std::size_t(k)];
     ExportedAction a = material_after
-                           ? make_action(k, present, nullptr, simulated, file, plan, machine, options, planned_before)
+                           ? make_action(k, present, nullptr, simulated, file, plan, machine, options, design, planned_before)
                            : make_action(k, planned[std::size_t(k)], &planned[std::size_t(k) + 1], simulated, file, plan,
-                                         machine, options);
+                                         machine, options, design);
     if (material_after) present = material_after(a);
     out.actions.push_back(std::move(a));
   }
@@ -189,8 +255,9 @@ ExportedAction export_planned_action(const plan::PlanFile& file, const plan::Pla
   if (k < 0 || std::size_t(k) >= plan.actions.size() || planned.size() != plan.actions.size() + 1)
     throw std::invalid_argument("export_planned_action: no action " + std::to_string(k) + " or not the plan's states");
   check_machine(file, machine);
+  DesignFrames design(file.design_mesh);
   return make_action(k, planned[std::size_t(k)], &planned[std::size_t(k) + 1], plan::simulated_domain(file, plan, machine),
-                     file, plan, machine, options);
+                     file, plan, machine, options, design);
 }
 
 }  // namespace hybridctl::toolpaths

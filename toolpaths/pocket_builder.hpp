@@ -3,7 +3,8 @@
 // toolpaths/pocket_*.cpp; pocket_path.hpp is the interface, docs/toolpaths.md the
 // description). pocket_path.cpp holds the steps of a run (material, allowed tips, levels,
 // clearing a level) and the moves; pocket_entry.cpp how the tool gets down to a pass
-// (plunge in air, lead-in, ramp).
+// (plunge in air, lead-in, ramp); pocket_finish.cpp the wall finishing passes of a level
+// (off the lattice, on the design's real walls: toolpaths/wall_finish.hpp).
 
 #include <cmath>
 #include <limits>
@@ -18,8 +19,14 @@
 #include "toolpaths/pocket_cells.hpp"
 #include "toolpaths/pocket_path.hpp"
 #include "toolpaths/pocket_tool.hpp"
+#include "toolpaths/wall_finish.hpp"
 
 namespace hybridctl::toolpaths::pocket {
+
+// Wall finishing's working parts (pocket_finish.cpp): what a tip height's passes must keep
+// to and clear of, and a piece of its contour to finish.
+struct FinishLevel;
+struct FinishRun;
 
 inline constexpr double kInf = std::numeric_limits<double>::infinity();
 // Heights are compared with this slack (mm): a tool tip this close above a voxel centre
@@ -39,7 +46,10 @@ class PocketBuilder {
   PocketBuilder(const config::CuttingTool& tool, const PocketOptions& options, Toolpath& path)
       : tool_(tool), options_(options), path_(path) {}
 
-  Toolpath& run(const geometry::Solid& roi, const geometry::Solid& keep, const geometry::Solid& stock);
+  // `design`: the design's voxels in the work frame, or null (then made from
+  // PocketOptions::design when finishing).
+  Toolpath& run(const geometry::Solid& roi, const geometry::Solid& keep, const geometry::Solid& stock,
+                const geometry::Solid* design = nullptr);
 
  private:
   using Solid = geometry::Solid;
@@ -61,6 +71,12 @@ class PocketBuilder {
   void report_what_stays();
 
   double centre_z(int k) const { return lattice_.origin.z + (k + 0.5) * h_; }
+  // The tip's height at level k: centre_z(k), or lower within the voxel (exact_heights).
+  double level_z(int k) const {
+    const auto it = level_heights_.find(k);
+    return it == level_heights_.end() ? centre_z(k) : it->second;
+  }
+  std::map<int, double> exact_heights(const Levels& levels) const;
   Vec3 at_cell(Cell c, double z) const {
     return {lattice_.origin.x + (c.x + 0.5) * h_, lattice_.origin.y + (c.y + 0.5) * h_, z};
   }
@@ -101,11 +117,38 @@ class PocketBuilder {
   bool in_air(Cell c, int k);
   // Rapids from safe_z (or from the first move) to above `c`, then down to `stop`.
   void go_above(Cell c, double stop);
+  void go_above(Point2 p, double stop);
   void plunge_in_air(Cell a, Cell b, double zk);
   void ramp_in(const CellPath& p, double zk, const SliceMask& usable);
   // Where the ramp from `b` along `d` over `m` cells starts: where the cutter first meets
   // material over its cells.
   double ramp_start(Cell b, Cell d, int m, double zk) const;
+
+  // Wall finishing (pocket_finish.cpp). Whether this run finishes walls, and what it needs.
+  void start_finishing(const Solid& roi, const Solid* design);
+  // The tip positions at height z where the tool would cut into the design.
+  TipKeepOut keep_out_at(double z) const;
+  // The cells of the tip domain whose centres lie in `region` (boundary included).
+  SliceMask cells_in(const TipKeepOut& region) const;
+  // The finishing passes with the tip at z (level k's height, or a face's above it) along
+  // the boundary of `keep_out`, where they finish what level k removes (the ROI's layers
+  // [k, k_above)).
+  void finish_walls(const TipKeepOut& keep_out, int k, int k_above, double z);
+  // What those passes must keep clear of; nothing when no wall there is this level's.
+  std::optional<FinishLevel> finish_level(const TipKeepOut& keep_out, int k, int k_above, double z) const;
+  std::optional<Point2> finish_lead(const FinishLevel& f, Point2 p, Point2 t, bool in) const;
+  // A run with its lead-in and lead-out points, or nothing when it has none.
+  std::optional<std::vector<Point2>> finish_pass(const FinishLevel& f, const FinishRun& run, Point2 from) const;
+  void cut_finish_pass(const FinishLevel& f, const std::vector<Point2>& pts);
+  // contact_height at any point (mm, work frame), not only at a cell's centre: exact for
+  // the voxels' column tops.
+  double contact_height_at(Point2 p, Part part) const;
+  double rapid_stop_at(Point2 p, double at_least) const;
+  Cell cell_of(Point2 p) const {
+    return {int(std::floor((p.x - lattice_.origin.x) / h_)), int(std::floor((p.y - lattice_.origin.y) / h_))};
+  }
+  // Removes from the material still there what the cutter takes along the polyline at `z`.
+  void stamp_polyline(const std::vector<Point2>& points, double z);
 
   config::CuttingTool tool_;
   PocketOptions options_;
@@ -125,10 +168,20 @@ class PocketBuilder {
   Vec3 at_{};
   bool started_ = false;
   bool at_level_ = false;
+  int level_ = 0;                        // the level being cut (voxel layer of the tip)
+  std::map<int, double> level_heights_;  // levels whose tip is not at the voxel centre
   std::vector<Cell> run_cells_;
   std::string pending_comment_;
   std::map<std::pair<int, int>, bool> air_cache_;  // per level, until the next removal
   int plunges_into_material_ = 0, skipped_entries_ = 0;
+  // Wall finishing.
+  bool finishing_ = false;
+  std::vector<ToolBand> finish_bands_;
+  double rough_margin_ = 0;  // mm the roughing's tips keep beyond the keep-out region
+  Solid roi_, design_;       // work frame
+  std::vector<double> face_heights_;  // of the design's faces square to the axis, top-down
+  int finish_passes_ = 0, finish_skipped_ = 0;
+  double finish_length_ = 0, finish_skipped_length_ = 0;  // mm
 };
 
 }  // namespace hybridctl::toolpaths::pocket

@@ -12,7 +12,7 @@ namespace hybridctl::toolpaths::pocket {
 bool PocketBuilder::in_air(Cell c, int k) {
   const auto key = std::pair<int, int>{c.x, c.y};
   if (const auto it = air_cache_.find(key); it != air_cache_.end()) return it->second;
-  const bool air = contact_height(c, Part::Whole) < centre_z(k) - kHeightSlack;
+  const bool air = contact_height(c, Part::Whole) < level_z(k) - kHeightSlack;
   air_cache_[key] = air;
   return air;
 }
@@ -39,7 +39,12 @@ std::optional<Cell> PocketBuilder::air_entry(const CellPath& p, int k, const Sli
 }
 
 void PocketBuilder::go_above(Cell c, double stop) {
-  const Vec3 top = at_cell(c, safe_z_);
+  const Vec3 centre = at_cell(c, 0);
+  go_above(Point2{centre.x, centre.y}, stop);
+}
+
+void PocketBuilder::go_above(Point2 p, double stop) {
+  const Vec3 top{p.x, p.y, safe_z_};
   if (!started_) {
     path_.start = top;
     started_ = true;
@@ -52,7 +57,7 @@ void PocketBuilder::go_above(Cell c, double stop) {
   } else {
     move(MoveKind::Rapid, {top.x, top.y, std::max(at_.z, safe_z_)}, 0, false);
   }
-  move(MoveKind::Rapid, at_cell(c, std::min(safe_z_, stop)), 0, false);
+  move(MoveKind::Rapid, {p.x, p.y, std::min(safe_z_, stop)}, 0, false);
 }
 
 // Down at `a`, where the whole tool meets nothing on the way, then over to the pass's
@@ -66,7 +71,7 @@ void PocketBuilder::plunge_in_air(Cell a, Cell b, double zk) {
 }
 
 bool PocketBuilder::enter(const CellPath& p, int k, const SliceMask& usable) {
-  const double zk = centre_z(k);
+  const double zk = level_z(k);
   const Cell b = p.points.front();
   // 1. Air all the way down, at the start or on the line before it: plunge there (and
   // lead in).

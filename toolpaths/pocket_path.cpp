@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <optional>
 #include <string>
 
 #include "common/number_text.hpp"
@@ -117,8 +118,7 @@ void PocketBuilder::stamp_run(int k) {
 
 void PocketBuilder::retract() {
   if (!at_level_) return;
-  const int k = int(std::floor((at_.z - lattice_.origin.z) / h_));
-  stamp_run(k);
+  stamp_run(level_);
   if (!model_.widening) {
     // Going up, a cutter wider than the shank above it sweeps new ground: feed up until
     // the tool is clear of everything still there.
@@ -146,7 +146,7 @@ void PocketBuilder::cut_along(const CellPath& p, double zk) {
 
 bool PocketBuilder::link_to_next(std::vector<CellPath>& todo, const std::vector<Candidate>& cands, int k,
                                  const SliceMask& usable) {
-  const double zk = centre_z(k);
+  const double zk = level_z(k);
   const Cell cur = current_cell();
   for (std::size_t i = 0; i < cands.size() && i < kLinkCandidates; ++i) {
     const CellPath probe = oriented(todo[cands[i].path], cands[i]);
@@ -182,7 +182,7 @@ void PocketBuilder::cut_paths(std::vector<CellPath> todo, int k, const SliceMask
         break;
       }
     const CellPath p = take(todo, cands[pick]);
-    if (enter(p, k, usable)) cut_along(p, centre_z(k));
+    if (enter(p, k, usable)) cut_along(p, level_z(k));
   }
 }
 
@@ -272,6 +272,28 @@ PocketBuilder::Levels PocketBuilder::cutting_levels() const {
   return levels;
 }
 
+// A flat cutter's tip anywhere in (centre - h, centre] of level k's voxels takes the same
+// voxels (none below: their centres lie under its flat bottom), so it goes to where the
+// part's face is: the highest floor of the design in that range, or, with nothing to keep
+// anywhere under the level, the bottom of its voxels (the start stock's face). A ball or
+// bull nose would sweep wider discs lower down: it stays at the centre.
+std::map<int, double> PocketBuilder::exact_heights(const Levels& levels) const {
+  std::map<int, double> out;
+  if (tool_.type != config::ToolType::Flat) return out;
+  constexpr double kSlack = 1e-9;  // mm
+  for (const int k : levels) {
+    const double c = centre_z(k);
+    double z = -kInf;
+    for (const geometry::Triangle& f : options_.floors)
+      if (f[0].z > c - h_ + 1e-6 && f[0].z <= c + kSlack) z = std::max(z, f[0].z);
+    if (std::isinf(z) && (k - 1 < untouchable_.storage_box().lo.z || k - 1 >= untouchable_.storage_box().hi.z ||
+                          slice_of(untouchable_, k - 1, work_).empty()))
+      z = c - h_ / 2;
+    if (!std::isinf(z) && z < c - kSlack) out[k] = z;
+  }
+  return out;
+}
+
 // ORs the untouchable voxels of row (y, z) into `held`, on remaining_'s words (words
 // are whole 64-voxel runs of X in every solid, so they line up).
 void PocketBuilder::held_rows(int y, int z, std::vector<std::uint64_t>& held) const {
@@ -319,7 +341,8 @@ SliceMask PocketBuilder::useful_tips(const SliceMask& usable, int k) const {
 
 void PocketBuilder::clear_level(const SliceMask& useful, const SliceMask& usable, int k, int level_number) {
   air_cache_.clear();
-  pending_comment_ = "level " + std::to_string(level_number) + " z=" + mm(centre_z(k));
+  level_ = k;
+  pending_comment_ = "level " + std::to_string(level_number) + " z=" + mm(level_z(k));
   if (options_.strategy == PocketStrategy::Zigzag) {
     const bool alternate = options_.raster == PocketRaster::Alternate;
     const bool along_x = options_.raster == PocketRaster::AlongX || (alternate && level_number % 2 == 1);
@@ -351,6 +374,10 @@ void PocketBuilder::report_what_stays() {
                              ".." + mm(mmbox.max.y) + ", z " + mm(mmbox.min.z) + ".." + mm(mmbox.max.z) +
                              " mm (work frame)");
   }
+  if (finish_skipped_ > 0 || finish_skipped_length_ > 0.5)
+    path_.warnings.push_back("wall finishing: " + mm(finish_skipped_length_) + " mm of the walls' contours not finished (" +
+                             std::to_string(finish_skipped_) +
+                             " passes with no lead-in or lead-out from air); the roughing left up to a voxel there");
   if (skipped_entries_ > 0)
     path_.warnings.push_back(std::to_string(skipped_entries_) +
                              " passes skipped: the shank or holder would meet material on the way down to them");
@@ -366,7 +393,7 @@ void PocketBuilder::report_what_stays() {
   }
 }
 
-Toolpath& PocketBuilder::run(const Solid& roi, const Solid& keep, const Solid& stock) {
+Toolpath& PocketBuilder::run(const Solid& roi, const Solid& keep, const Solid& stock, const Solid* design) {
   lattice_ = roi.lattice();
   h_ = lattice_.voxel_size;
   model_ = make_tool(tool_, h_);
@@ -378,13 +405,32 @@ Toolpath& PocketBuilder::run(const Solid& roi, const Solid& keep, const Solid& s
   work_ = {{rb.lo.x - margin, rb.lo.y - margin, rb.lo.z}, {rb.hi.x + margin, rb.hi.y + margin, all_.hi.z + 1}};
   const Solid allowed = allowed_tips();
   start_column_tops();
+  const Levels levels = cutting_levels();
+  level_heights_ = exact_heights(levels);
+  start_finishing(roi, design);
   int level_number = 0;
-  for (const int k : cutting_levels()) {
+  int k_above = rb.hi.z;  // the ROI's layers [k, k_above) are level k's to remove
+  double z_above = lattice_.origin.z + rb.hi.z * h_;
+  for (const int k : levels) {
     if (remaining_.empty()) break;
-    const SliceMask usable = usable_tips(allowed, k);
+    SliceMask usable = usable_tips(allowed, k);
+    std::optional<TipKeepOut> keep_out;
+    if (finishing_) {
+      // The roughing keeps the cutter off the design's real surface, not only off the
+      // voxel centres; the finishing passes take what that leaves.
+      keep_out = keep_out_at(level_z(k));
+      if (!keep_out->empty()) usable = usable.without(cells_in(keep_out->grown(rough_margin_)));
+    }
     const SliceMask useful = useful_tips(usable, k);
-    if (useful.empty()) continue;
-    clear_level(useful, usable, k, ++level_number);
+    if (!useful.empty()) clear_level(useful, usable, k, ++level_number);
+    if (keep_out) {
+      finish_walls(*keep_out, k, k_above, level_z(k));
+      // Walls that end at a face between this level and the one above, from that face.
+      for (const double zf : face_heights_)
+        if (zf > level_z(k) + 1e-6 && zf < z_above - 1e-6) finish_walls(keep_out_at(zf), k, k_above, zf);
+    }
+    k_above = k;
+    z_above = level_z(k);
   }
   if (started_ && at_.z < safe_z_) move(MoveKind::Rapid, {at_.x, at_.y, safe_z_}, 0, false);
   report_what_stays();
@@ -413,8 +459,15 @@ Toolpath pocket_path(const geometry::Solid& roi_part, const geometry::Solid& kee
   const Solid roi = part_to_work(roi_part, setup.approach);
   const Solid keep = keep_part.empty() ? Solid(roi.lattice(), {}) : part_to_work(keep_part, setup.approach);
   const Solid stock = stock_part.empty() ? Solid(roi.lattice(), {}) : part_to_work(stock_part, setup.approach);
+  std::optional<Solid> design;
+  if (options.design_voxels && options.design && !options.design->empty() && options.finish_walls &&
+      tool.type == config::ToolType::Flat) {
+    if (!(options.design_voxels->lattice() == roi_part.lattice()))
+      throw std::invalid_argument("pocket_path: the design's voxels are on another lattice than the ROI");
+    design = part_to_work(*options.design_voxels, setup.approach);
+  }
   pocket::PocketBuilder builder(tool, options, path);
-  builder.run(roi, keep, stock);
+  builder.run(roi, keep, stock, design ? &*design : nullptr);
   return path;
 }
 

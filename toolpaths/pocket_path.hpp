@@ -6,8 +6,8 @@
 //   Toolpath p = pocket_path(roi, keep, stock_before, tool, setup);
 //
 // Work frame (toolpaths/setup_frame.hpp): the tool axis is +Z. Tool positions are the tool
-// tip (the lowest point of the cutter, on its axis), always on voxel centres sideways,
-// and on voxel-centre heights at the cutting levels. Levels go top-down at the tool's
+// tip (the lowest point of the cutter, on its axis), on voxel centres sideways (the wall
+// finishing passes excepted), at the levels' heights. Levels go top-down at the tool's
 // step_down and include every floor of the ROI. At each level the tool tip stays in the
 // allowed region: where the whole tool (cutter, shank, holder) touches no voxel of
 // `keep`, computed once in 3D by dilating `keep` with the reflected tool. The useful
@@ -16,11 +16,15 @@
 // linked by feed moves inside the allowed region, otherwise by retracting to safe_z.
 // Entries plunge only where the tool meets no material on the way down; elsewhere they
 // lead in sideways from air, or ramp along the first segment at ramp_angle_deg.
+// Given the design's STL (PocketOptions::design), a flat cutter then follows the design's
+// real walls at each level (wall finishing), off the lattice.
 
+#include <memory>
 #include <optional>
 
 #include "config/machine.hpp"
 #include "toolpaths/toolpath.hpp"
+#include "geometry/mesh.hpp"
 #include "geometry/solid.hpp"
 
 namespace hybridctl::toolpaths {
@@ -55,6 +59,27 @@ struct PocketOptions {
   double material_allowance = 1.0;
   // safe_z: this far (mm) above the highest material in the domain.
   double safe_clearance = 5.0;
+  // The design's faces that face the tool (work frame, each level at one height: exact,
+  // from the STL: geometry::axis_square_faces of plan::PlanFile::design_mesh). A flat cutter's level over such a floor cuts
+  // at the floor's height rather than at the voxel centre above it, and a level with nothing
+  // to keep under it at the bottom of its voxels: on the voxels the same cut, on the part
+  // no lip of up to a voxel left on the floor (docs/toolpaths.md, "Levels").
+  std::vector<geometry::Triangle> floors;
+  // The design's surface (work frame: the STL's facets turned as the floors are, closed,
+  // duplicate facets removed: geometry::clean_mesh), shared rather than copied per action;
+  // null or empty for a design made on voxels, or for an action that cuts into the design
+  // on purpose (a later deposit lays it again). With it, a flat cutter finishes the walls
+  // exactly (docs/toolpaths.md, "Wall finishing"): after each level is roughed, its side
+  // follows the design's real walls at the level's height (toolpaths/wall_finish.hpp), and
+  // the roughing keeps the cutter off the design between voxel centres too, design voxels
+  // of the ROI included.
+  std::shared_ptr<const std::vector<geometry::Triangle>> design;
+  // The design's voxels (part frame, on the solids' lattice), which the finishing passes
+  // leave to the exact surface: null makes them from `design` (centres inside it, as the
+  // planner voxelizes).
+  const geometry::Solid* design_voxels = nullptr;
+  // Wall finishing on (default) or off (the roughing alone, for comparison).
+  bool finish_walls = true;
   // Overrides of the tool's step_down and step_over (mm).
   std::optional<double> step_down;
   std::optional<double> step_over;
@@ -72,7 +97,8 @@ struct PocketOptions {
 // Defects (Toolpath::defects, the part will be wrong): no tool position reaches the ROI
 // at all ("unreachable"). Warnings: ROI the tool cannot reach (volume and extent: corners
 // a round tool leaves; the part as built judges them against the tolerance), entries with
-// no room to ramp, passes skipped because the shank or holder would meet material.
+// no room to ramp, passes skipped because the shank or holder would meet material, wall
+// finishing passes left out for want of a lead-in or lead-out from air.
 Toolpath pocket_path(const geometry::Solid& roi, const geometry::Solid& keep, const geometry::Solid& stock_before,
                      const config::CuttingTool& tool, const config::Setup& setup, const PocketOptions& options = {});
 

@@ -59,40 +59,44 @@ ToolModel make_tool(const config::CuttingTool& tool_in, double h) {
     if (r2 < widest - 1e-9) m.widening = false;
     widest = std::max(widest, r2);
   }
-  return m;
-}
-
-std::vector<ReachOffset> reach_offsets(const ToolModel& m, double h) {
-  // The running maximum of the squared radius along the axis, sampled finely; the first
-  // height where it reaches rho^2, minus one sample (rounded towards the tip: safe).
-  const double step = h / kProfileSamplesPerVoxel;
+  // The running maximum of the squared radius along the axis, sampled finely.
+  m.profile_step = h / kProfileSamplesPerVoxel;
   double finite_end = 0;
   for (const auto* secs : {&m.cutting, &m.body})
     for (const AxialSection& s : *secs) finite_end = std::max(finite_end, std::isinf(s.to) ? s.from : s.to);
-  const int n = int(std::ceil((finite_end + h) / step)) + 1;
+  const int n = int(std::ceil((finite_end + h) / m.profile_step)) + 1;
   auto running = [&](const std::vector<AxialSection>& secs) {
     std::vector<double> r(std::size_t(n), -1);
     double best = -1;
     for (int i = 0; i < n; ++i) {
-      best = std::max(best, radius_squared_at(secs, i * step));
+      best = std::max(best, radius_squared_at(secs, i * m.profile_step));
       r[std::size_t(i)] = best;
     }
     return r;
   };
-  std::vector<AxialSection> whole = m.cutting;
-  whole.insert(whole.end(), m.body.begin(), m.body.end());
-  const std::vector<double> run_whole = running(whole), run_cut = running(m.cutting), run_body = running(m.body);
-  auto first_reach = [&](const std::vector<double>& run, double rho2) {
-    const auto it = std::lower_bound(run.begin(), run.end(), rho2 - 1e-9);
-    if (it == run.end()) return kInf;
-    return std::max(0.0, double(it - run.begin() - 1) * step);
-  };
+  m.run_whole = running(whole);
+  m.run_cutter = running(m.cutting);
+  m.run_body = running(m.body);
+  return m;
+}
+
+double first_reach(const std::vector<double>& run, double step, double rho2) {
+  const auto it = std::lower_bound(run.begin(), run.end(), rho2 - 1e-9);
+  if (it == run.end()) return kInf;
+  return std::max(0.0, double(it - run.begin() - 1) * step);
+}
+
+std::vector<ReachOffset> reach_offsets(const ToolModel& m, double h) {
+  // The first height where the running maximum of the squared radius reaches rho^2, minus
+  // one sample (rounded towards the tip: safe).
+  auto first_reach_of = [&](const std::vector<double>& run, double rho2) { return first_reach(run, m.profile_step, rho2); };
   const int R = int(std::floor(m.max_radius / h));
   std::vector<ReachOffset> out;
   for (int dy = -R; dy <= R; ++dy)
     for (int dx = -R; dx <= R; ++dx) {
       const double rho2 = double(dx * dx + dy * dy) * h * h;
-      ReachOffset o{dx, dy, first_reach(run_whole, rho2), first_reach(run_cut, rho2), first_reach(run_body, rho2)};
+      ReachOffset o{dx, dy, first_reach_of(m.run_whole, rho2), first_reach_of(m.run_cutter, rho2),
+                    first_reach_of(m.run_body, rho2)};
       if (!std::isinf(o.zmin_whole)) out.push_back(o);
     }
   return out;

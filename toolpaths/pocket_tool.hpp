@@ -28,7 +28,16 @@ struct ToolModel {
   // The body (shank, holder) as discs: radius (voxels, conservative along the axis as the
   // guard is) and the lowest level above the tip where it starts.
   std::vector<std::pair<double, int>> body_discs;
+  // The running maximum of the squared radius along the axis (the whole tool, the cutter,
+  // the body), sampled every `profile_step` mm from the tip to a voxel past the shank.
+  std::vector<double> run_whole, run_cutter, run_body;
+  double profile_step = 0;
 };
+
+// The lowest height above the tip (mm) at which the running profile `run` reaches the
+// squared distance `rho2` (mm^2) from the axis, rounded down by a sample (safe); infinity
+// when never.
+double first_reach(const std::vector<double>& run, double step, double rho2);
 
 // The model of `tool` (its defaults applied: instruments::with_defaults) on a lattice of
 // voxel size `h`.

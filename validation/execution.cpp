@@ -226,7 +226,7 @@ class IncrementalRun {
                             "missing_material", last, 0,
                             "after action " + std::to_string(last) + " (" + p.name +
                                 "), the last that adds material, " + fixed_number(missing.volume(), 1) +
-                                " mm^3 of the design's core (the design shrunk by the tolerance, which a part within it "
+                                " mm^3 of the design's core (the design shrunk by the planning band, which a part within it "
                                 "holds) is missing, and the removals after it cannot add it",
                             where}};
   }
@@ -403,7 +403,7 @@ Execution run_plan(const plan::PlanFile& file, const plan::PlanFilePlan& plan, c
     run.take(out.exported.programs());
   }
   out.program = run.finish(out);
-  out.deviation = plan::measure_deviation(out.as_built, file.design, file.domain, file.tolerance);
+  out.deviation = plan::measure_deviation(out.as_built, file.design, file.domain, file.band());
   out.reasons = rejection_reasons(out, file, machine);
   if (out.reasons.empty() && options.verify_exactly && options.planned_against == PlannedAgainst::MaterialPresent)
     verify_exactly(out, file, plan, machine, options);

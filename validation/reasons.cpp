@@ -137,7 +137,7 @@ std::vector<RejectionReason> rejection_reasons(const Execution& run, const plan:
   add_path_defects(run, machine, out);
   add_incidents(run, machine, out);
   for (const std::string& e : run.errors) out.push_back({"refused_line", 0, 0, e, std::nullopt});
-  if (run.stopped_after == 0) add_deviation(run, file.tolerance, out);  // stopped early: not measured
+  if (run.stopped_after == 0) add_deviation(run, file.band(), out);  // stopped early: not measured
   return out;
 }
 

@@ -36,7 +36,8 @@ Vec3 vec(const Vector& v) { return {v.x(), v.y(), v.z()}; }
 // or the piece is smaller than half a spacing square: each leaf's centroid is a sample
 // standing for the leaf's area (about spacing^2 on a large face; a facet smaller than
 // that is one sample).
-void sample_triangle(const Triangle3& t, const Vector& normal, double spacing, std::vector<SurfaceSample>& out) {
+void sample_triangle(const Triangle3& t, const Vector& normal, double spacing, std::uint32_t index,
+                     std::vector<SurfaceSample>& out) {
   std::vector<Triangle3> stack{t};
   const double limit = 4 * spacing * spacing;
   // A piece already smaller than half a spacing square is not split on: the slivers of a
@@ -53,7 +54,7 @@ void sample_triangle(const Triangle3& t, const Vector& normal, double spacing, s
     }
     if (longest <= limit || f.squared_area() <= sliver) {
       const Point c = CGAL::centroid(f);
-      out.push_back({{c.x(), c.y(), c.z()}, vec(normal), 0, 0, std::sqrt(f.squared_area())});
+      out.push_back({{c.x(), c.y(), c.z()}, vec(normal), 0, 0, std::sqrt(f.squared_area()), index});
       continue;
     }
     const Point& a = f[edge];
@@ -86,7 +87,10 @@ DesignSurface::DesignSurface(const geometry::TriangleMesh& mesh, const std::stri
   const geometry::TriangleMesh clean = geometry::clean_mesh(mesh);
   for (const geometry::Triangle& t : clean.triangles) {
     Triangle3 tri(point(t[0]), point(t[1]), point(t[2]));
-    if (tri.squared_area() > 1e-18) tree_->triangles.push_back(tri);
+    if (tri.squared_area() > 1e-18) {
+      tree_->triangles.push_back(tri);
+      triangles_.push_back(t);
+    }
   }
   if (tree_->triangles.empty()) throw InputError(name + ": the mesh has no triangle with an area to verify against");
   tree_->tree.insert(tree_->triangles.begin(), tree_->triangles.end());
@@ -113,7 +117,7 @@ DesignSurface::DesignSurface(const geometry::TriangleMesh& mesh, const std::stri
   for (;;) {
     samples_.clear();
     for (std::size_t i = 0; i < tree_->triangles.size(); ++i)
-      sample_triangle(tree_->triangles[i], normals[i], options_.spacing, samples_);
+      sample_triangle(tree_->triangles[i], normals[i], options_.spacing, std::uint32_t(i), samples_);
     if (samples_.size() <= options_.max_samples) break;
     options_.spacing *= 1.05 * std::sqrt(double(samples_.size()) / double(options_.max_samples));
   }

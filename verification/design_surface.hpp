@@ -6,6 +6,7 @@
 // part; distances and rays use CGAL's AABB tree over the triangles.
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -21,6 +22,7 @@ struct SurfaceSample {
   double inward = 0;      // how far the vector reaches into the design
   double outward = 0;     // and out of it
   double area = 0;        // mm^2 of the surface the sample stands for
+  std::uint32_t triangle = 0;  // the triangle of DesignSurface::triangles() it was cut from
 };
 
 class FrameIndex;
@@ -48,6 +50,11 @@ class DesignSurface {
   DesignSurface& operator=(DesignSurface&&) noexcept;
 
   const std::vector<SurfaceSample>& samples() const { return samples_; }
+  // The mesh's triangles that were sampled, in the STL's order: the mesh cleaned
+  // (geometry::clean_mesh: degenerate and repeated facets dropped) and without the ones
+  // of no area. Every sample names the one it was cut from (SurfaceSample::triangle), so
+  // a figure per sample can be shown on the design's own facets (the job report).
+  const std::vector<geometry::Triangle>& triangles() const { return triangles_; }
   const SamplingOptions& options() const { return options_; }
   double area() const { return area_; }
   // Distance from `p` to the nearest point of the surface, mm.
@@ -60,6 +67,7 @@ class DesignSurface {
   struct Tree;
   std::unique_ptr<Tree> tree_;
   std::vector<SurfaceSample> samples_;
+  std::vector<geometry::Triangle> triangles_;
   SamplingOptions options_;
   double area_ = 0;
 };

@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <map>
 
 #include <tbb/parallel_for.h>
 #include <optional>
 
+#include "common/error.hpp"
 #include "gcode/interpreter.hpp"
 #include "instruments/bead.hpp"
 #include "instruments/cutter.hpp"
@@ -167,8 +169,10 @@ class Verifier {
     });
   }
 
-  plan::ExactDeviation result(double tolerance) const {
-    plan::ExactDeviation out;
+  SurfaceDeviation result(double tolerance) const {
+    SurfaceDeviation whole;
+    whole.samples.resize(runs_.size());
+    plan::ExactDeviation& out = whole.summary;
     out.tolerance = tolerance;
     out.spacing = surface_.options().spacing;
     out.samples = runs_.size();
@@ -216,11 +220,12 @@ class Verifier {
         if (!gouge.at) gouge.at = s.point, gouge.action = surface_op->action, gouge.line = surface_op->line;
       }
       if (excess.mm <= tolerance && gouge.mm <= tolerance) within += s.area;
+      whole.samples[i] = {excess.mm, gouge.mm, surface_op ? surface_op->action : 0, deposited};
       if (excess.at && (!out.excess.at || excess.mm > out.excess.mm)) out.excess = excess;
       if (gouge.at && (!out.gouge.at || gouge.mm > out.gouge.mm)) out.gouge = gouge;
     }
     out.within_share = total > 0 ? within / total : 1.0;
-    return out;
+    return whole;
   }
 
   void set_ceiling(double z) { ceiling_ = z; }
@@ -259,6 +264,12 @@ class Verifier {
 plan::ExactDeviation verify_program(const DesignSurface& surface, const config::Machine& machine,
                                     const gcode::PostedProgram& program, const geometry::Solid& start_stock,
                                     const VerifyOptions& options) {
+  return measure_program(surface, machine, program, start_stock, options).summary;
+}
+
+SurfaceDeviation measure_program(const DesignSurface& surface, const config::Machine& machine,
+                                 const gcode::PostedProgram& program, const geometry::Solid& start_stock,
+                                 const VerifyOptions& options) {
   Verifier verifier(surface, machine, start_stock);
   // Infinite bodies stop at the machine's whole travel: nothing of the part lies above it.
   double travel = 0;
@@ -293,16 +304,16 @@ const DesignSurface* DesignSurfaces::for_plan(const plan::PlanFile& file) {
   const double voxel = file.lattice.voxel_size;
   if (surface_ && tolerance_ == file.tolerance && voxel_ == voxel) return surface_.get();
   if (!mesh_) {
-    std::filesystem::path path(file.part);
-    if (path.is_relative() && !file.directory.empty()) path = file.directory / path;
+    // The STL the plan file read (plan::PlanFile::design_mesh); none: nothing to verify against.
     std::error_code ec;
-    // The copy the plan directory holds, wherever it was copied to; else the part it names.
-    if (!file.directory.empty() && std::filesystem::is_regular_file(file.directory / plan::kDesignStl, ec))
-      path = file.directory / plan::kDesignStl;
-    else if (file.part.empty())
-      return nullptr;
-    name_ = path.string();
-    mesh_ = geometry::read_stl(path);
+    if (file.design_mesh.triangles.empty()) {
+      if (file.part.empty()) return nullptr;
+      throw InputError((file.directory / plan::kDesignStl).string() + ": not found, and neither is the part the plan names (" +
+                       file.part + "): exact verification needs the design's STL; expected a plan directory as `plan -o` writes it");
+    }
+    const bool copy = !file.directory.empty() && std::filesystem::is_regular_file(file.directory / plan::kDesignStl, ec);
+    name_ = copy ? (file.directory / plan::kDesignStl).string() : file.part;
+    mesh_ = file.design_mesh;
   }
   surface_ = std::make_unique<DesignSurface>(*mesh_, name_, sampling_for(file.tolerance, voxel));
   tolerance_ = file.tolerance;

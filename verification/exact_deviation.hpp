@@ -46,6 +46,27 @@ plan::ExactDeviation verify_program(const DesignSurface& surface, const config::
                                     const gcode::PostedProgram& program, const geometry::Solid& start_stock,
                                     const VerifyOptions& options);
 
+// What the part made is at one sample of the surface, as the summary counts it: how far
+// its material stands out beyond the design's surface and how deep its air lies under it
+// (0: none; an as-deposited face carries its head's accuracy both ways), and the action
+// whose move left that surface (0: the start stock).
+struct SampleDeviation {
+  double excess = 0;  // mm
+  double gouge = 0;   // mm
+  int action = 0;
+  bool as_deposited = false;
+};
+
+// The summary and every sample's figures, in the order of surface.samples(): for a
+// report that paints the design's mesh, and for tests that compare sections.
+struct SurfaceDeviation {
+  plan::ExactDeviation summary;
+  std::vector<SampleDeviation> samples;
+};
+SurfaceDeviation measure_program(const DesignSurface& surface, const config::Machine& machine,
+                                 const gcode::PostedProgram& program, const geometry::Solid& start_stock,
+                                 const VerifyOptions& options);
+
 // The design's surface for a plan file, sampled once for its tolerance and voxel
 // (sampling_for) and kept: from a mesh in memory (planning, which has read the STL), or from
 // the STL the plan file names (export, run and dry-run of a plan directory).
@@ -53,10 +74,10 @@ class DesignSurfaces {
  public:
   DesignSurfaces() = default;
   DesignSurfaces(geometry::TriangleMesh mesh, std::string name);
-  // Null when there is no real surface to verify against: no mesh was given, the plan
-  // directory holds no design.stl and the plan file names no part (a design made on
-  // voxels, as tests make them). Throws InputError naming the STL when the one found
-  // cannot be read.
+  // From the mesh given, else the plan file's (plan::PlanFile::design_mesh). Null when
+  // there is no real surface to verify against: no mesh, and the plan file names no part
+  // (a design made on voxels, as tests make them). Throws InputError when it names a part
+  // and neither its STL nor the directory's design.stl is there.
   const DesignSurface* for_plan(const plan::PlanFile& file);
 
  private:

@@ -177,11 +177,9 @@ bool same_partition(const AtomDecomposition& a, const AtomDecomposition& b) {
   return true;
 }
 
-bool strict_slivers(double tolerance, double voxel_size) { return tolerance < voxel_size; }
-
-AtomClass class_of(const AtomMeasures& a, bool strict_slivers) {
+AtomClass class_of(const AtomMeasures& a) {
   const bool in = a.voxels_in_core > 0 || a.thin_feature, out = a.voxels_beyond_hull > 0 || a.thin_gap;
-  return a.sliver && ((in && out) || !strict_slivers) ? AtomClass::Free
+  return a.sliver ? AtomClass::Free
          : in && out ? AtomClass::Violating
          : in        ? AtomClass::MustIn
          : out       ? AtomClass::MustOut
@@ -260,7 +258,6 @@ std::vector<AtomMeasures> measure_atoms(const AtomDecomposition& atoms, const So
     }
   });
   const double h = atoms.lattice().voxel_size, v = h * h * h;
-  const bool strict = strict_slivers(zone.tolerance, h);
   for (int i = 0; i < m; ++i) {
     AtomMeasures& a = out[std::size_t(i)];
     a.volume = double(a.voxels) * v;
@@ -272,7 +269,7 @@ std::vector<AtomMeasures> measure_atoms(const AtomDecomposition& atoms, const So
                     a.centroid.z + s.z / double(a.voxels) * h};
     }
     a.sliver = a.volume < sliver_threshold_mm3;
-    a.atom_class = class_of(a, strict);
+    a.atom_class = class_of(a);
   }
   mark_thin_parts(atoms, design, zone, out);
   return out;

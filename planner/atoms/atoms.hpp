@@ -91,20 +91,11 @@ struct AtomMeasures {
   bool sliver = false;
 };
 
-// The class from the measures and flags above. A sliver is free (noise of the primitives'
-// edges) when it holds both a voxel every plan must keep and one every plan must leave
-// empty, and with `strict_slivers` false whatever it holds; otherwise it is classed as any
-// atom (strict_slivers: see below).
-AtomClass class_of(const AtomMeasures& m, bool strict_slivers);
-
-// Whether slivers that hold only design or only air are classed as any atom: when the
-// tolerance is under a voxel, a voxel too many or too few is out of tolerance, and a
-// sliver left free was seen only when every candidate failed on it (an arc wall on a plate
-// on multitask-b-axis: 200 rejected). At a tolerance of a voxel or more they stay free:
-// there the model's slivers are noise a real plan gets within tolerance (a cross of ribs,
-// deposited whole and executed within tolerance, whose strict slivers no sequence gets
-// right).
-bool strict_slivers(double tolerance, double voxel_size);
+// The class from the measures and flags above. A sliver is free whatever it holds: the
+// zone is a planning band of at least a voxel (plan/planning_band.hpp), where the model's
+// slivers are noise of the primitives' edges that a real plan gets within the band (a
+// cross of ribs, deposited whole, whose slivers no sequence gets right on the voxels).
+AtomClass class_of(const AtomMeasures& m);
 
 // Measures and classifies every atom, thin features and gaps included.
 std::vector<AtomMeasures> measure_atoms(const AtomDecomposition& atoms, const Solid& design, const ToleranceZone& zone,

@@ -172,7 +172,7 @@ Verdict core_verdict(const PlanningProblem& p, const CoreProof& proof, const std
       names += (k ? ", " : "") + p.primitives[std::size_t(va.primitives[k])].name;
     if (va.primitives.size() > 4) names += " and " + std::to_string(va.primitives.size() - 4) + " more";
     va.description = "a " + format("%.3g", m.volume) + " mm\u00B3 region " +
-                     (in ? "of the design" : out ? "outside the design" : "in the tolerance band") + " around " +
+                     (in ? "of the design" : out ? "outside the design" : "in the planning band") + " around " +
                      format("(%.1f, %.1f, %.1f)", m.centroid.x, m.centroid.y, m.centroid.z) + " mm" +
                      (in ? " (must be made)" : out ? " (must be left empty)" : " (carries or blocks the others)") +
                      (names.empty() ? ", in no primitive" : ", in " + names);

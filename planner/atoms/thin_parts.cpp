@@ -123,7 +123,7 @@ void cover(const AtomDecomposition& atoms, const Solid& design, const Solid& reg
     if (std::get<0>(best) < 0) continue;
     AtomMeasures& a = m[std::size_t(atoms.atom_at(chosen))];
     (material ? a.thin_feature : a.thin_gap) = true;
-    a.atom_class = class_of(a, strict_slivers(tolerance, atoms.lattice().voxel_size));
+    a.atom_class = class_of(a);
     if (!a.sliver)
       around(chosen, offsets, [&](Index3 w) {
         if (pending.contains(w)) pending.set(w, false);

@@ -334,6 +334,7 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
                    {"volume", r.design_volume},
                    {"bounding_box", box_json(r.design.bounding_box_mm())}};
   doc["tolerance"] = r.tolerance;
+  doc["band"] = r.band;
   doc["sliver_threshold"] = r.sliver_threshold;
   doc["objective"] = std::string(config::to_string(r.objective));
   doc["currency"] = r.currency;
@@ -487,30 +488,14 @@ void write_plan_directory(const PlanningResult& r, const ReportSources& src, con
   }
 }
 
-// Below a voxel the tolerance leaves no play (docs/plan-format.md, "Tolerance"): worth
-// saying when no plan came out, as a round bore milled on such a grid never matches it.
-std::string finer_than_voxel_note(const PlanningResult& r) {
-  double finer = r.lattice.voxel_size;
-  while (r.tolerance > 0 && finer > r.tolerance) finer /= 2;
-  auto text = [](double mm) {
-    std::ostringstream os;
-    os << mm;
-    return os.str();
-  };
-  const std::string h = text(r.lattice.voxel_size), t = text(r.tolerance);
-  return "note        the tolerance (" + t + " mm) is finer than a voxel (" + h + " mm): a voxel too many or too few is " +
-         h + " mm off, so only a part made voxel for voxel is within it, and a cutter's or a bead's voxels seldom "
-         "follow a round or sloping face that exactly; the verdict is for this grid: --tolerance " + h +
-         " (at least a voxel)" + (r.tolerance > 0 ? " or --voxel " + text(finer) + " (no larger than the tolerance)" : "") +
-         " gives such faces the one voxel of play they need (docs/plan-format.md, \"Tolerance\")\n";
-}
-
 std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
   std::ostringstream os;
   const geometry::IndexBox b = r.design.bounding_box();
   os << "design      " << src.part_path << ": " << fixed(r.design_volume, 1) << " mm\u00B3, " << (b.hi.x - b.lo.x) << " x "
      << (b.hi.y - b.lo.y) << " x " << (b.hi.z - b.lo.z) << " voxels of " << r.lattice.voxel_size << " mm\n";
-  os << "machine     " << src.machine_name << " (" << src.machine_path << "), tolerance " << r.tolerance << " mm\n";
+  os << "machine     " << src.machine_name << " (" << src.machine_path << "), tolerance " << r.tolerance << " mm"
+     << (r.band > r.tolerance ? " on the STL's surface (the voxels are judged within a band of " + shortest_number(r.band) + " mm)" : "")
+     << "\n";
   os << "objective   " << objective_text(r) << "\n";
   os << "primitives  " << r.primitives.size() << "\n";
   for (const Primitive& p : r.primitives) {
@@ -544,7 +529,6 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
   if (r.verdict.violations.size() > shown) os << "  ... and " << r.verdict.violations.size() - shown << " more in plan.json\n";
   os << stock_starts_text(r);
   if (r.validated) os << rejected_summary(r);
-  if (r.plans.empty() && r.tolerance < r.lattice.voxel_size) os << finer_than_voxel_note(r);
   if (!r.plans.empty()) {
     os << "plans       " << r.plans.size() << " (A*: " << r.search.expanded << " states expanded in "
        << fixed(r.search.seconds, 2) << " s";
@@ -583,7 +567,7 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
       const json toolpaths = toolpath_total(r, k);
       if (!toolpaths.is_null()) os << "; toolpaths " << duration_text(toolpaths.get<double>());
       os << "\n";
-      os << "     deviation: " << plan::deviation_text(d, r.tolerance) << " (voxels)\n";
+      os << "     deviation: " << plan::deviation_text(d, r.band) << " (voxels)\n";
       if (k < r.exact_deviations.size() && r.exact_deviations[k])
         os << "     exact:     " << plan::exact_deviation_text(*r.exact_deviations[k]) << "\n";
       for (std::size_t s = 0; s < plan.steps.size(); ++s) {
@@ -621,6 +605,7 @@ plan::PlanFile to_plan_file(const PlanningResult& r, const ReportSources& source
   f.lattice = r.lattice;
   f.domain = r.domain;
   f.tolerance = r.tolerance;
+  f.design_mesh = r.design_mesh;
   f.design = plan::as_read_back(r.design, f.lattice, f.domain);
   for (const Primitive& p : r.primitives) {
     f.primitives.push_back({p.name, p.label, p.kind, p.mode, primitive_capability(p, directory), p.setup, p.tool_number,

@@ -1,4 +1,6 @@
 #include "planner/pipeline/planning.hpp"
+
+#include "plan/planning_band.hpp"
 #include "planner/pipeline/rank.hpp"
 
 #include <algorithm>
@@ -143,7 +145,7 @@ std::vector<Primitive> all_primitives(const config::Machine& machine, const Plan
   std::vector<Primitive> filled;
   if (options.filled) filled = filled_primitives(machine, r.design, r.domain, primitives);
   if (options.bands) {
-    for (Primitive& p : banded_primitives(machine, r.design, r.tolerance, r.domain, primitives))
+    for (Primitive& p : banded_primitives(machine, r.design, r.band, r.domain, primitives))
       primitives.push_back(std::move(p));
   }
   for (Primitive& p : filled) {
@@ -152,7 +154,7 @@ std::vector<Primitive> all_primitives(const config::Machine& machine, const Plan
   }
   if (stocks.size() == 1) {
     // A repair: deposits near what the stock lacks, milled back where the head reaches.
-    for (Primitive& p : repair_primitives(machine, r.design, primitives.front().region, r.tolerance, r.domain, primitives)) {
+    for (Primitive& p : repair_primitives(machine, r.design, primitives.front().region, r.band, r.domain, primitives)) {
       p.name = primitive_name(primitives.size());
       primitives.push_back(std::move(p));
     }
@@ -180,7 +182,7 @@ Atoms decompose_into_atoms(const Progress& progress, const PlanningResult& r) {
     out.decomposition.add_primitive(r.primitives[i].region);
     progress("atoms", double(i + 1) / double(r.primitives.size()));
   }
-  out.measures = measure_atoms(out.decomposition, r.design, make_tolerance_zone(r.design, r.tolerance), r.sliver_threshold);
+  out.measures = measure_atoms(out.decomposition, r.design, make_tolerance_zone(r.design, r.band), r.sliver_threshold);
   return out;
 }
 
@@ -288,14 +290,16 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
   const config::Planning& defaults = machine.planning;
   const double h = options.voxel_size > 0 ? options.voxel_size : defaults.voxel_size;
   r.tolerance = options.tolerance >= 0 ? options.tolerance : defaults.tolerance;
+  r.band = plan::planning_band(r.tolerance, h);
+  r.design_mesh = part;
   r.sliver_threshold = options.sliver_threshold >= 0 ? options.sliver_threshold : defaults.sliver_threshold;
   const int top_k = options.top_k > 0 ? options.top_k : defaults.top_k;
   r.objective = options.objective.value_or(defaults.objective);
   r.currency = machine.costs.currency;
 
   // Before anything large is allocated: a grid over the budget is an input error.
-  check_planning_memory(geometry::bounds(part), machine, h, r.tolerance, options.memory_budget, part_name);
-  PlanningGrid grid = voxelize_design(part, part_name, machine, h, r.tolerance, progress);
+  check_planning_memory(geometry::bounds(part), machine, h, r.band, options.memory_budget, part_name);
+  PlanningGrid grid = voxelize_design(part, part_name, machine, h, r.band, progress);
   r.lattice = grid.lattice;
   r.domain = grid.domain;
   r.design = std::move(grid.design);
@@ -310,7 +314,7 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
   clock.lap("atoms");
   if (options.fine_graining) {
     const Solid* present = options.stock_files.size() == 1 ? &r.primitives.front().region : nullptr;
-    r.fine_graining = fine_grain(machine, r.design, r.tolerance, r.sliver_threshold, present, r.primitives, r.atoms, r.measures);
+    r.fine_graining = fine_grain(machine, r.design, r.band, r.sliver_threshold, present, r.primitives, r.atoms, r.measures);
     clock.lap("fine-graining");
   }
   r.problem = symbolic_problem(r, machine, options.max_uses);
@@ -338,7 +342,7 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
     r.timings.emplace_back("validate", validation_seconds);
   }
   for (const Plan& plan : r.plans) {
-    r.deviations.push_back(plan::measure_deviation(plan_outcome(r, plan), r.design, r.domain, r.tolerance));
+    r.deviations.push_back(plan::measure_deviation(plan_outcome(r, plan), r.design, r.domain, r.band));
     r.estimates.push_back(estimate_plan(machine, r.primitives, plan));
     if (options.toolpath_minutes) r.toolpath_minutes.push_back(options.toolpath_minutes(plan));
     r.exact_deviations.push_back(options.exact_deviation ? options.exact_deviation(plan) : std::nullopt);

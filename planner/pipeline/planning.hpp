@@ -101,7 +101,9 @@ struct PlanningResult {
   geometry::Solid design;
   double design_volume = 0;        // mm^3
   double bounding_box_volume = 0;  // mm^3: the cost normaliser
-  double tolerance = 0;
+  double tolerance = 0;  // mm, the part's: exact verification holds the plans to it
+  double band = 0;       // mm, the planning band the voxels are judged with (plan/planning_band.hpp)
+  geometry::TriangleMesh design_mesh;  // the part as given (plan::PlanFile::design_mesh)
   double sliver_threshold = 0;
   std::vector<Primitive> primitives;
   AtomDecomposition atoms{geometry::Lattice{}, geometry::IndexBox{{0, 0, 0}, {1, 1, 1}}};

@@ -4,7 +4,7 @@
 'use strict';
 (function () {
   const data = JSON.parse(document.getElementById('report-data').textContent);
-  const report = { ready: false, errors: [], framed: null, layer: null, shown: null, visible: {} };
+  const report = { ready: false, errors: [], framed: null, layer: null, shown: null, exactPlan: null, visible: {} };
   window.hybridctlReport = report;
 
   // One colour per meaning, shared with the PNG snapshots (report/report.cpp).
@@ -14,6 +14,12 @@
     current: 0x111111, built: 0xb0b8c4, over_within: 0xf4a259, over_beyond: 0xc8161d, under_within: 0x7fb7e6,
     under_beyond: 0x1d3fbf, alarm: 0xff00aa, place: 0x7a1fa2,
   };
+  // The exact deviation's scale, as report/report_exact.cpp's exact_colour (the snapshots):
+  // neutral at 0, to orange at +tolerance (excess) and to blue at -tolerance (gouge); beyond
+  // the tolerance a flat dark red or dark violet, and the facet outlined in yellow; facets
+  // left as deposited dashed in green.
+  const kExact = { neutral: 0xdde1e6, excess: 0xf08a24, excessBeyond: 0xb3121a, gouge: 0x3a86d4, gougeBeyond: 0x3b1a86,
+                   outline: 0xffd21f, deposited: 0x13a84a };
   const kPrimitiveColours = [0x4e79a7, 0xf28e2b, 0x59a14f, 0xb07aa1, 0x76b7b2, 0xedc948, 0xff9da7, 0x9c755f, 0xbab0ac, 0xe15759];
   const degToRad = (THREE.MathUtils || THREE.Math).degToRad;  // THREE.Math until r113
   const kViewDirection = new THREE.Vector3(1.0, -1.6, 1.1).normalize();  // as report/snapshot.cpp
@@ -357,6 +363,7 @@
       report.layer = null;
     }
     setVisible('design', false);
+    hideExact();
     report.shown = { plan: planIndex, action: actionIndex };
     document.querySelectorAll('.state').forEach((e) =>
       e.classList.toggle('selected', Number(e.dataset.plan) === planIndex && Number(e.dataset.action) === actionIndex));
@@ -403,11 +410,20 @@
       head.append(el('h3', '', 'Plan ' + plan.rank), el('span', 'expr', plan.expression || ''));
       const dev = plan.deviation || {};
       const facts = ['cost ' + fmt(plan.cost, 4), 'cycle ' + duration(plan.cycle_s), (plan.actions || []).length + ' actions',
-                     'worst deviation ' + fmt(dev.worst_distance, 2) + ' mm' + (dev.within_tolerance === false ? ' (beyond tolerance)' : '')];
+                     'worst deviation on the voxels ' + fmt(dev.worst_distance, 2) + ' mm' + (dev.within_tolerance === false ? ' (beyond tolerance)' : '')];
+      const exact = plan.exact_map && plan.exact_map.summary ? plan.exact_map.summary : dev.exact;
+      if (exact) facts.push('exact: excess ' + fmt(exact.max_excess_mm, 3) + ' mm, gouge ' + fmt(exact.max_gouge_mm, 3) + ' mm' +
+                            (exact.within_tolerance === false ? ' (beyond tolerance)' : ''));
       if (typeof plan.gap === 'number') facts.push('gap ' + fmt(plan.gap * 100, 1) + ' %');
       if (plan.optimal !== undefined) facts.push(plan.optimal ? 'proven optimal' : 'not proven optimal');
       if (plan.toolpath_error) facts.push('no toolpaths: ' + plan.toolpath_error);
       head.append(el('span', 'facts', facts.join(' · ')));
+      if (plan.exact_map && !plan.exact_map.error && layers.exact) {
+        const show = el('button', 'exact-plan', 'exact deviation on the design');
+        show.dataset.plan = k;
+        show.addEventListener('click', () => showExact(k));
+        head.append(show);
+      }
       div.append(head);
       const strip = el('div', 'strip');
       (plan.actions || []).forEach((action, a) => {
@@ -459,16 +475,22 @@
     const panel = document.getElementById('as-built-panel');
     panel.hidden = false;
     panel.append(el('h2', '', 'As built (dry run)'));
+    panel.append(el('div', 'note', 'What this run built, on the plan\'s voxels: it shows what the run did (an alarm that ' +
+                    'stopped it, lines it did not execute) and volumes, and deviations deeper than exact verification\'s ' +
+                    'vectors reach. How far the surface is from the design is measured to a voxel here; the exact ' +
+                    'deviation above measures it on the STL itself.'));
     const list = el('div');
     panel.append(list);
     addLayer('as-built', meshOf(b.built, kColours.built, 0.5), false, 'as built\n' + vol(b.built_volume));
     toggle(list, 'as-built', 'as built', kColours.built, vol(b.built_volume));
-    const labels = { over_within: 'beyond the design, within tolerance', over_beyond: 'beyond the design and the tolerance',
-                     under_within: 'missing, within tolerance', under_beyond: 'missing, deeper than the tolerance' };
+    const labels = { over_within: 'beyond the design, within the band', over_beyond: 'beyond the design and the band',
+                     under_within: 'missing, within the band', under_beyond: 'missing, deeper than the band' };
+    // Over the exact map they would hide the facets it paints: shown at first only without one.
+    const bandsShown = !exactMaps.some(Boolean);
     for (const [band, label] of Object.entries(labels)) {
       const entry = (b.bands || {})[band];
       if (!entry) continue;
-      addLayer('deviation:' + band, meshOf(entry.mesh, kColours[band], 1), true, label + '\n' + vol(entry.volume));
+      addLayer('deviation:' + band, meshOf(entry.mesh, kColours[band], 1), bandsShown, label + '\n' + vol(entry.volume));
       toggle(list, 'deviation:' + band, label, kColours[band], vol(entry.volume));
       legendEntries.push(['deviation:' + band, label, kColours[band]]);
     }
@@ -484,6 +506,211 @@
     });
   }
 
+  // ---- exact deviation on the design's own mesh (report/report_exact.hpp) ----------------------
+  // Each facet of the STL coloured by the worst of its samples for the plan shown: signed
+  // (excess one way, gouge the other), beyond the tolerance in flat dark colours and outlined.
+  const floats = (b64) => new Float32Array(bytes(b64).buffer);
+  let exactShown = null;  // the plan index whose map is shown
+  const exactMaps = [];   // per plan: decoded figures, or null
+  function rgb(hex) { return [((hex >> 16) & 255) / 255, ((hex >> 8) & 255) / 255, (hex & 255) / 255]; }
+  function exactColour(v, tol) {
+    tol = tol > 0 ? tol : 1e-9;
+    if (v > tol) return rgb(kExact.excessBeyond);
+    if (v < -tol) return rgb(kExact.gougeBeyond);
+    const a = rgb(kExact.neutral), b = rgb(v >= 0 ? kExact.excess : kExact.gouge), t = Math.min(1, Math.abs(v) / tol);
+    return [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t];
+  }
+  function actionName(plan, a) {
+    if (!a) return 'the start stock';
+    const action = (plan.actions || [])[a - 1];
+    return 'action ' + a + (action ? ' (' + action.primitive + ' ' + (action.label || '') + ')' : '');
+  }
+  function decodeExact(plan) {
+    const m = plan.exact_map;
+    if (!m || m.error || !m.excess) return null;
+    return { excess: floats(m.excess), gouge: floats(m.gouge), action: new Uint16Array(bytes(m.action).buffer),
+             deposited: bytes(m.deposited), summary: m.summary || {} };
+  }
+  // Line segments along the edges of the facets `pick` selects, from the non-indexed positions.
+  function facetEdges(pos, count, pick) {
+    const out = [];
+    for (let t = 0; t < count; ++t) {
+      if (!pick(t)) continue;
+      for (let e = 0; e < 3; ++e) {
+        const a = (t * 3 + e) * 3, b = (t * 3 + (e + 1) % 3) * 3;
+        out.push(pos[a], pos[a + 1], pos[a + 2], pos[b], pos[b + 1], pos[b + 2]);
+      }
+    }
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(out), 3));
+    return g;
+  }
+
+  function buildExact() {
+    const surface = (data.design || {}).surface;
+    const plans = data.plans || [];
+    if (!surface || !plans.length) return;
+    const panel = document.getElementById('exact-panel');
+    panel.hidden = false;
+    panel.append(el('h2', '', 'Exact deviation on the design'));
+    if (surface.error || !surface.mesh) {
+      panel.append(el('div', 'note', 'No exact deviation map: ' + (surface.error || 'no mesh')));
+      return;
+    }
+    plans.forEach((plan) => exactMaps.push(decodeExact(plan)));
+    if (!exactMaps.some(Boolean)) {
+      panel.append(el('div', 'note', 'No plan could be replayed: ' + plans.map((p) => 'plan ' + p.rank + ': ' +
+                                     ((p.exact_map && p.exact_map.error) || 'not measured')).join('; ')));
+      return;
+    }
+    const g = decodeMesh(surface.mesh).toNonIndexed();
+    const count = surface.triangles;
+    g.setAttribute('color', new THREE.BufferAttribute(new Float32Array(count * 9), 3));
+    const material = new THREE.MeshPhongMaterial({
+      vertexColors: THREE.VertexColors !== undefined ? THREE.VertexColors : true, flatShading: true, side: THREE.DoubleSide,
+      shininess: 20, polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1,
+    });
+    const mesh = new THREE.Mesh(g, material);
+    mesh.userData.faceInfo = (t) => {
+      const m = exactMaps[exactShown], plan = plans[exactShown];
+      if (!m) return 'design (' + surface.file + ')';
+      return 'plan ' + plan.rank + ', facet ' + t + ' of ' + surface.file + '\nexcess ' + fmt(m.excess[t], 3) + ' mm, gouge ' +
+             fmt(m.gouge[t], 3) + ' mm (worst of its samples)\nleft by ' + actionName(plan, m.action[t]) +
+             (m.deposited[t] ? '\nleft as deposited' : '');
+    };
+    addLayer('exact', mesh, false, 'exact deviation');
+    const none = () => facetEdges(new Float32Array(0), 0, () => false);
+    addLayer('exact:beyond', new THREE.LineSegments(none(), new THREE.LineBasicMaterial({ color: kExact.outline })),
+             false, 'facets beyond the tolerance');
+    addLayer('exact:deposited', new THREE.LineSegments(none(),
+                                                      new THREE.LineDashedMaterial({ color: kExact.deposited, dashSize: 1.2, gapSize: 0.8 })),
+             false, 'facets left as deposited');
+    addLayer('exact:worst', new THREE.Group(), false, 'largest excess and deepest gouge');
+    const list = document.getElementById('layers');
+    list.append(el('div', 'group', 'Exact deviation'));
+    toggle(list, 'exact', 'the design\'s mesh (' + surface.file + '), coloured', kExact.excess, count + ' facets');
+    toggle(list, 'exact:beyond', 'outline: beyond the tolerance', kExact.outline);
+    toggle(list, 'exact:deposited', 'dashed: left as deposited', kExact.deposited);
+    toggle(list, 'exact:worst', 'markers: largest excess, deepest gouge', kExact.excessBeyond);
+
+    panel.append(el('div', 'note', surface.file + ', ' + count + ' facets: each coloured by the worst of its samples ' +
+                    'for the plan chosen (its program replayed from its start stock as validation runs it, the part it ' +
+                    'makes measured against the STL by exact verification). Hover a facet for its figures.'));
+    const buttons = el('div', 'exact-plans');
+    plans.forEach((plan, k) => {
+      const b = el('button', 'exact-plan', 'Plan ' + plan.rank);
+      b.dataset.plan = k;
+      if (!exactMaps[k]) { b.disabled = true; b.title = (plan.exact_map && plan.exact_map.error) || 'not measured'; }
+      b.addEventListener('click', () => showExact(k));
+      buttons.append(b);
+    });
+    panel.append(buttons);
+    const tol = data.tolerance;
+    const stops = [[0, kExact.gougeBeyond], [14, kExact.gougeBeyond], [14, kExact.gouge], [50, kExact.neutral], [86, kExact.excess],
+                   [86, kExact.excessBeyond], [100, kExact.excessBeyond]];
+    const scale = el('div', 'exact-scale');
+    scale.style.background = 'linear-gradient(to right, ' +
+      stops.map(([at, c]) => '#' + c.toString(16).padStart(6, '0') + ' ' + at + '%').join(', ') + ')';
+    const labels = el('div', 'exact-scale-labels');
+    for (const text of ['gouge > ' + fmt(tol, 2), '−' + fmt(tol, 2), '0', '+' + fmt(tol, 2), 'excess > ' + fmt(tol, 2) + ' mm'])
+      labels.append(el('span', '', text));
+    panel.append(scale, labels);
+    const figures = el('div');
+    figures.id = 'exact-figures';
+    panel.append(figures);
+  }
+
+  function hideExact() {
+    for (const name of ['exact', 'exact:beyond', 'exact:deposited', 'exact:worst']) setVisible(name, false);
+    document.querySelectorAll('.exact-plan').forEach((b) => b.classList.remove('selected'));
+  }
+
+  function showExact(k) {
+    const m = exactMaps[k], plan = data.plans[k], surface = data.design.surface;
+    if (!m || !layers.exact) return;
+    if (shownState) { scene.remove(shownState); delete layers.state; }
+    if (shownPath) { scene.remove(shownPath.object); delete layers.toolpath; }
+    shownState = shownPath = null;
+    document.getElementById('path-controls').hidden = true;
+    report.layer = null;
+    report.shown = null;
+    document.querySelectorAll('.state').forEach((e) => e.classList.remove('selected'));
+    exactShown = k;
+    report.exactPlan = k;
+    const tol = data.tolerance, count = surface.triangles;
+    const g = layers.exact.geometry, colours = g.getAttribute('color');
+    for (let t = 0; t < count; ++t) {
+      const v = m.excess[t] >= m.gouge[t] ? m.excess[t] : -m.gouge[t], c = exactColour(v, tol);
+      for (let j = 0; j < 3; ++j) colours.setXYZ(t * 3 + j, c[0], c[1], c[2]);
+    }
+    colours.needsUpdate = true;
+    const pos = g.getAttribute('position').array;
+    layers['exact:beyond'].geometry.dispose();
+    layers['exact:beyond'].geometry = facetEdges(pos, count, (t) => m.excess[t] > tol || m.gouge[t] > tol);
+    layers['exact:deposited'].geometry.dispose();
+    layers['exact:deposited'].geometry = facetEdges(pos, count, (t) => m.deposited[t] > 0);
+    layers['exact:deposited'].computeLineDistances();
+    // The largest excess and the deepest gouge, marked where they are (seen through the part).
+    const worst = layers['exact:worst'];
+    worst.children.slice().forEach((c) => { worst.remove(c); c.traverse((o) => { if (o.geometry) o.geometry.dispose(); }); });
+    const size = Math.max(0.8, 1.5 * (data.voxel_size || 0.5));
+    for (const [p, colour, what] of [[m.summary.excess, kExact.excessBeyond, 'largest excess'], [m.summary.gouge, kExact.gougeBeyond, 'deepest gouge']]) {
+      if (!p || !p.at || !(p.mm > 0)) continue;
+      // A dot in the direction's colour in a white ring where it is in sight, and faint
+      // where the part hides it (so that one behind the part is not taken for one on it).
+      const marker = new THREE.Mesh(new THREE.SphereBufferGeometry(size, 16, 12),
+                                    new THREE.MeshBasicMaterial({ color: colour, transparent: true, opacity: 1 }));
+      marker.renderOrder = 16;  // after its ring, which leaves the depth as it was
+      const ring = new THREE.Mesh(new THREE.SphereBufferGeometry(size * 1.6, 16, 12),
+                                  new THREE.MeshBasicMaterial({ color: 0xffffff, transparent: true, opacity: 0.9, depthWrite: false }));
+      ring.renderOrder = 15;
+      const ghost = new THREE.Mesh(new THREE.SphereBufferGeometry(size * 1.6, 16, 12),
+                                   new THREE.MeshBasicMaterial({ color: colour, depthTest: false, depthWrite: false,
+                                                                 transparent: true, opacity: 0.3 }));
+      ghost.renderOrder = 14;
+      marker.add(ring, ghost);
+      marker.position.set(p.at[0], p.at[1], p.at[2]);
+      marker.userData.info = 'plan ' + plan.rank + ': ' + what + ' ' + fmt(p.mm, 3) + ' mm at ' + xyz(p.at) + '\nleft by ' +
+                             actionName(plan, p.action) + (p.line ? ', line ' + p.line : '');
+      worst.add(marker);
+    }
+    setVisible('design', false);
+    for (const name of ['exact', 'exact:beyond', 'exact:deposited', 'exact:worst']) setVisible(name, true);
+    document.querySelectorAll('.exact-plan').forEach((b) => b.classList.toggle('selected', Number(b.dataset.plan) === k));
+
+    const box = document.getElementById('exact-figures');
+    box.textContent = '';
+    const s = m.summary;
+    const figure = (what, p, colour) => {
+      if (!p) return;
+      const beyond = p.mm > tol;
+      const text = what + ' ' + (p.at_least ? 'at least ' : '') + fmt(p.mm, 3) + ' mm' + (p.at ? ' at ' + xyz(p.at) : '') +
+                   (p.at ? ', left by ' + actionName(plan, p.action) + (p.line ? ', line ' + p.line : '') : '') +
+                   (p.as_deposited ? ', as deposited' : '') + (beyond ? ' · beyond the tolerance' : '');
+      const item = el('div', 'exact-figure' + (p.at ? ' placed' : '') + (beyond ? ' beyond' : ''), text);
+      item.style.borderLeftColor = '#' + colour.toString(16).padStart(6, '0');
+      if (p.at) item.addEventListener('click', () => place(p.at, colour, 'Plan ' + plan.rank + ': ' + text));
+      box.append(item);
+    };
+    box.append(el('h3', '', 'Plan ' + plan.rank + ': ' + (s.within_tolerance ? 'within' : 'OUTSIDE') + ' the tolerance of ' +
+                            fmt(tol, 2) + ' mm'));
+    figure('Largest excess', s.excess, s.excess && s.excess.mm > tol ? kExact.excessBeyond : kExact.excess);
+    figure('Deepest gouge', s.gouge, s.gouge && s.gouge.mm > tol ? kExact.gougeBeyond : kExact.gouge);
+    const map = plan.exact_map;
+    box.append(el('div', 'numbers', fmt(100 * s.within_share, 1) + ' % of the surface within the tolerance both ways · ' +
+                                    map.beyond_triangles + ' facets beyond it (outlined) · ' + map.deposited_triangles +
+                                    ' left as deposited (dashed) · ' + s.samples + ' samples ' + fmt(s.spacing, 2) + ' mm apart'));
+    setCaption('Plan ' + plan.rank + ' · exact deviation on the design\'s mesh (' + surface.file + ')');
+    legendEntries.splice(0, legendEntries.length, ...legendEntries.filter((e) => !e[0].startsWith('exact')));
+    legendEntries.push(['exact', 'excess beyond ' + fmt(tol, 2) + ' mm', kExact.excessBeyond],
+                       ['exact', 'excess', kExact.excess], ['exact', 'on the design', kExact.neutral],
+                       ['exact', 'gouge', kExact.gouge], ['exact', 'gouge beyond ' + fmt(tol, 2) + ' mm', kExact.gougeBeyond]);
+    if (map.beyond_triangles > 0) legendEntries.push(['exact:beyond', 'outlined: beyond the tolerance', kExact.outline]);
+    if (map.deposited_triangles > 0) legendEntries.push(['exact:deposited', 'left as deposited', kExact.deposited]);
+    updateLegend();
+    requestRender();
+  }
+
   // ---- hover -------------------------------------------------------------------------------
   const raycaster = new THREE.Raycaster();
   const tooltip = document.getElementById('tooltip');
@@ -495,7 +722,8 @@
     scene.traverseVisible((o) => { if (o.isMesh) candidates.push(o); });
     const hit = raycaster.intersectObjects(candidates, false)[0];
     if (!hit) { tooltip.hidden = true; return; }
-    let o = hit.object, info = o.userData.info;
+    let o = hit.object, info = o.userData.faceInfo && hit.faceIndex !== undefined && hit.faceIndex !== null
+      ? o.userData.faceInfo(hit.faceIndex) : o.userData.info;
     while (!info && o.parent) { o = o.parent; info = o.userData.info; }
     const p = hit.point;
     tooltip.textContent = (info || o.name) + '\nat ' + xyz([p.x, p.y, p.z]);
@@ -553,6 +781,7 @@
     buildHeader();
     buildModel();
     buildVerdict();
+    buildExact();
     buildPlans();
     buildRejected();
     buildAsBuilt();
@@ -565,6 +794,9 @@
     frame(all);
     setCaption((data.verdict && (data.verdict.outcome || (data.verdict.manufacturable ? 'manufacturable' : '')) === 'manufacturable') ? 'Design' : 'Design and its offending atoms');
     updateLegend();
+    // A part with plans opens on the best plan's exact deviation on the design's mesh.
+    const first = exactMaps.findIndex(Boolean);
+    if (first >= 0) showExact(first);
     renderer.render(scene, camera);
     drawThumbnails().then(() => { report.ready = true; requestRender(); });
   }
@@ -592,5 +824,6 @@
   report.setVisible = setVisible;
   report.frameAtom = frameAtom;
   report.showState = showState;
+  report.showExact = showExact;
   report.setLayer = setLayer;
 })();

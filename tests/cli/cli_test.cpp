@@ -149,19 +149,18 @@ const std::string kBAxisMachine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples
 const std::string kParts = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/";
 
 // The B-axis machine's 66 primitives (issue 15): the bound that prices removals with the
-// design they cut proves the block milled to the bracket optimal, and the plan is executed
-// from the block before it is offered.
-TEST_F(Cli, TheBracketOnTheBAxisMachineIsMilledFromTheBlockProvenOptimal) {
-  // The search alone (executed, its lowest cuts leave a lip as the tube's do, below).
+// design they cut proves the block milled to the bracket within a few percent of optimal
+// (with a band of a voxel, plan/planning_band.hpp, more atoms are free and the exact
+// search stops at its limit; weighted A* finds it with its gap).
+TEST_F(Cli, TheBracketOnTheBAxisMachineIsMilledFromTheBlockWithinAProvenGap) {
+  // The search alone.
   const Outcome r = run({"plan", kBracket, "--machine", kBAxisMachine, "--top", "1", "--no-validate", "-o", (dir_ / "plan").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
-  EXPECT_NE(r.out.find("proven optimal"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("% of optimal (proven)"), std::string::npos) << r.out;
   // The first action is the block (P2), not a deposit finished by milling.
   const std::size_t first = r.out.find("  1. (");
   ASSERT_NE(first, std::string::npos) << r.out;
   EXPECT_EQ(r.out.compare(r.out.find('P', first), 3, "P2 "), 0) << r.out;
-  const std::string json = slurp(dir_ / "plan" / "plan.json");
-  EXPECT_NE(json.find("\"found_by\": \"exact-search\""), std::string::npos);
 }
 
 // The overhang's slab hangs 15 mm out on every side of its column. On the B-axis machine
@@ -176,9 +175,9 @@ TEST_F(Cli, TheOverhangOnTheBAxisMachineIsProvenImpossibleBeforeAnySearch) {
   EXPECT_NE(r.out.find("(must be made), in "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("(must be left empty), in "), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("rejected"), std::string::npos) << r.out;
-  // The machine file's 0.3 mm is below its 0.5 mm voxel: the verdict says it is for this grid.
-  EXPECT_NE(r.out.find("note        the tolerance (0.3 mm) is finer than a voxel (0.5 mm)"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("--tolerance 0.5 (at least a voxel) or --voxel 0.25 (no larger than the tolerance)"),
+  // The machine file's 0.3 mm is below its 0.5 mm voxel: the voxels are judged within a
+  // band of a voxel, the part against the STL at 0.3 mm.
+  EXPECT_NE(r.out.find("tolerance 0.3 mm on the STL's surface (the voxels are judged within a band of 0.5 mm)"),
             std::string::npos)
       << r.out;
   const std::string json = slurp(dir_ / "plan" / "plan.json");
@@ -187,57 +186,51 @@ TEST_F(Cli, TheOverhangOnTheBAxisMachineIsProvenImpossibleBeforeAnySearch) {
 }
 
 // The slots on the B-axis machine at its own tolerance (0.3 mm, under the 0.5 mm voxel):
-// no cutter fits a slot, so they are never to be filled, and the voxels at the top corners
-// beside them are atoms of their own (slivers, classed as any atom since they hold only
-// design) that no deposit lays without filling a slot too: a bead rounds a corner by a
-// voxel, 0.5 mm. `plan` proves it before any candidate is executed (it used to take a
-// rejected candidate and a correction to say UNDECIDED), and says what would do.
-TEST_F(Cli, TheSlotsOnTheBAxisMachineAreProvenNotManufacturableAtItsToleranceBeforeAnyExecution) {
+// no cutter fits a slot, so the block is deposited round them. With the tolerance as the
+// voxels' band, the voxels at the top corners beside the slots, which a bead rounds by a
+// voxel, made the part "NOT manufacturable" over 0.125 mm^3 regions; within a band of a
+// voxel they are not a verdict, and the deposit is judged where it matters, on the STL:
+// its faces left as deposited stand out beyond 0.3 mm with the head's accuracy.
+TEST_F(Cli, TheSlotsOnTheBAxisMachineAreJudgedOnTheStlNotRefusedOverCornerVoxels) {
   const Outcome r = run({"plan", kParts + "slots.stl", "--machine", kBAxisMachine, "-o", (dir_ / "plan").string()});
   EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
-  EXPECT_NE(r.out.find("verdict     NOT manufacturable: not manufacturable: 8 atoms of the design no deposit makes "
-                       "without material outside it that only removals cutting into the atom clear"),
-            std::string::npos)
-      << r.out;
-  EXPECT_NE(r.out.find("  - a 0.125 mm\u00B3 region of the design around (15.8, 0.2, 19.8) mm: every deposit that holds it"),
-            std::string::npos)
-      << r.out;
-  EXPECT_EQ(r.out.find("  x ("), std::string::npos) << r.out;  // no candidate executed
-  EXPECT_NE(r.out.find("note        the tolerance (0.3 mm) is finer than a voxel (0.5 mm)"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("verdict     NOT manufacturable"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("region of the design around (15.8, 0.2, 19.8) mm"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(exact verification, tolerance 0.3 mm, as deposited)"), std::string::npos) << r.out;
 }
 
 // A tube on a plate on the B-axis machine, with a tolerance of one voxel: the bore's edge
 // with the plate is a sharp concave ring whose voxels a cutter's sweep on the grid misses
 // here and there, so the atom kept clear there is one beside it that the 12 mm flat
-// clears (planner/atoms/thin_parts.hpp). Milled from the block, each plan executed.
-// (The search alone: executed, the block's plans leave the lip below their lowest voxel
-// centre, as the next test shows.)
+// clears (planner/atoms/thin_parts.hpp). Milled from the block: the search alone.
 TEST_F(Cli, TheTubeOnAPlateIsMilledFromTheBlockOnTheBAxisMachineAtAToleranceOfAVoxel) {
   const Outcome r = run({"plan", kParts + "tube-plate.stl", "--machine", kBAxisMachine, "--tolerance", "0.5", "--no-validate"});
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("plans       3 ("), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("  1. ((((P2 \u2212 "), std::string::npos) << r.out;  // from the block
   EXPECT_NE(r.out.find("proven optimal"), std::string::npos) << r.out;
-  EXPECT_EQ(r.out.find("finer than a voxel"), std::string::npos) << r.out;
 }
 
-// The same tube at the B-axis machine's own tolerance, 0.3 mm, under a voxel: only a part
-// made voxel for voxel is within it, and no cutter's voxels follow the bore. The block's
-// own proof before the search replays a plan from it: the block milled down to the plate
-// and the tube deposited, each layer's contour bead along its faces (docs/search.md, "Each
-// raw stock proven on its own"). It is offered first, executed voxel for voxel.
+// The same tube at the B-axis machine's own tolerance, 0.3 mm, under a voxel: the voxels
+// are judged within a band of a voxel (plan/planning_band.hpp), the part against the STL.
 //
-// Against the STL it is not: the milling's lowest level is a voxel centre, 0.25 mm above
-// the plate's bottom, and leaves the block's margin there as a lip round the plate, which
-// exact verification finds (docs/verification.md) and names; the voxels cannot.
-TEST_F(Cli, TheTubeOnAPlateAtTheMachinesToleranceIsRefusedForTheLipItsLowestCutLeaves) {
+// Against the STL the roughing's tips on voxel centres used to bite into the tube's round
+// wall between the voxel centres they spare, 0.43 mm deep (exact verification found it,
+// docs/verification.md; the voxels cannot), and every plan was refused. The flat cutters
+// now keep off the STL's real walls and finish them on it (docs/toolpaths.md, "Wall
+// finishing"): the block's plan is offered, and what is left off the surface is the 10 mm
+// bull nose's (action 4: no wall finishing for bull noses yet), within the 0.3 mm. (Its
+// lowest cut used to sit on a voxel centre 0.25 mm above the plate's bottom and leave the
+// block's margin there as a lip; the floor is now cut at its real height.)
+TEST_F(Cli, TheTubeOnAPlateAtTheMachinesToleranceIsMilledFromTheBlockWithItsWallsFinished) {
   const Outcome r = run({"plan", kParts + "tube-plate.stl", "--machine", kBAxisMachine});
-  ASSERT_EQ(r.exit_code, 4) << r.err << r.out;
-  EXPECT_NE(r.out.find("  x (((P2 \u2212 "), std::string::npos) << r.out;  // from the block, rejected
-  EXPECT_NE(r.out.find("exact_excess: the part made stands out of the design's surface by at least 1.200 mm "
-                       "(exact verification, tolerance 0.3 mm) (at -1.2, 1.04, 0.19 mm)"),
-            std::string::npos)
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("  1. ((((P2 \u2212 "), std::string::npos) << r.out;  // from the block
+  EXPECT_EQ(r.out.find("exact_gouge: action 2"), std::string::npos) << r.out;  // the rougher's bite is gone
+  EXPECT_NE(r.out.find("exact:     excess 0.249 mm at (25.01, 32.25, 29.25) by action 4 (line "), std::string::npos)
       << r.out;
+  EXPECT_NE(r.out.find("gouge 0.216 mm at (20.21, 18.83, 29.78) by action 4 (line "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("at least"), std::string::npos) << r.out;  // no lip of the margin
 }
 
 // A wall leaning 30 degrees on hybrid-3axis, deposited on its milled base: each layer's
@@ -387,7 +380,6 @@ TEST_F(Cli, APartTheMachineCannotMakeExitsWithFour) {
   const Outcome r = run({"plan", kBracket, "--machine", machine.string(), "--voxel", "2", "--tolerance", "2"});
   EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
   EXPECT_NE(r.out.find("NOT manufacturable"), std::string::npos) << r.out;
-  EXPECT_EQ(r.out.find("finer than a voxel"), std::string::npos) << r.out;  // a tolerance of a voxel has play
 }
 
 TEST_F(Cli, PlanArgumentsAreChecked) {

@@ -47,8 +47,8 @@ Priced best_plan(const std::string& out) {
 // plate's top, milled to size after) and mills the plate's margin. Without the plate the best plan mills the part from a block, and
 // costs more in money and in minutes: both are printed in the same run.
 //
-// The search's choice alone: executed, both leave the plate's margin as a lip below the
-// lowest cut's voxel centre, which exact verification refuses (docs/verification.md).
+// The search's choice alone (validation judges the parts against the STL, a different
+// question, docs/verification.md).
 TEST_F(Costs, TheBossIsDepositedOnAPlateWhenTheRatesMakeThatCheaperThanMillingItFromABlock) {
   const Outcome on_plate = run_hybridctl({"plan", kBossPlate, "--machine", kTitanium, "--top", "1", "--no-validate"});
   ASSERT_EQ(on_plate.exit_code, 0) << on_plate.err << on_plate.out;

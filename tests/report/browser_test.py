@@ -14,8 +14,13 @@ checks, as a user would see it:
   - toggling a primitive's checkbox changes the picture;
   - (the part that cannot be made) each violating atom is listed, and clicking it frames
     it: the page says so and red pixels of the atom show;
-  - (the flanged hub) clicking an action's state card shows its toolpath, and moving the
-    layer slider changes what is drawn.
+  - (the flanged hub) the page opens on plan 1's exact deviation painted on the STL's own
+    facets (as many per plan as design.stl has); the map of the plan with the most excess
+    is not the plain design's picture and shows the scale's colours (plan 1's walls are
+    finished on the STL: nearly neutral); the panel beside it names the largest excess and
+    the deepest gouge with their lines; another plan's map can be chosen;
+  - (the flanged hub) clicking an action's state card shows its toolpath (and hides the
+    map), and moving the layer slider changes what is drawn.
 
 Screenshots of these states are written under BUILD/tests/report/screens/. Chromium
 missing is a failure, not a skip: scripts/setup installs it.
@@ -179,6 +184,13 @@ def changed_pixels(a, b, box):
     return sum(1 for v in diff.getdata() if v > 24)
 
 
+def stl_triangles(path):
+    """The facets of a binary STL (the plan directory's design.stl)."""
+    with open(path, "rb") as f:
+        head = f.read(84)
+    return int.from_bytes(head[80:84], "little")
+
+
 def run(cmd):
     r = subprocess.run(cmd, capture_output=True, text=True)
     return r.returncode, r.stdout + r.stderr
@@ -210,11 +222,53 @@ def check_common(browser, name, screens):
     return box
 
 
-def check_flanged_hub(browser, page, screens):
+def check_exact_map(browser, screens, stl_triangles):
+    """The flanged hub's page opens on plan 1's exact deviation on the design's own mesh."""
+    box = browser.canvas_box()
+    check(browser.evaluate("hybridctlReport.exactPlan") == 0,
+          "flanged hub: the page did not open on plan 1's exact deviation map")
+    check(browser.evaluate("hybridctlReport.visible['exact'] === true && hybridctlReport.visible['design'] === false"),
+          "flanged hub: the exact map is not what is shown")
+    counts = browser.evaluate(
+        "(() => { const d = JSON.parse(document.getElementById('report-data').textContent);"
+        " return [d.design.surface.triangles].concat(d.plans.map(p => p.exact_map ? p.exact_map.triangles : null)); })()")
+    check(all(c == stl_triangles for c in counts),
+          "flanged hub: the exact maps have %s triangles, design.stl has %d" % (counts, stl_triangles))
+    browser.screenshot(os.path.join(screens, "flanged-hub-exact-plan-1.png"))
+    # Plan 1 mills with flat end mills only: wall finishing puts its walls on the STL
+    # (docs/toolpaths.md), nearly neutral on the scale. The plan with the most excess (the
+    # ball finisher's, on the top) shows the scale's colours.
+    most = browser.evaluate(
+        "(() => { const d = JSON.parse(document.getElementById('report-data').textContent);"
+        " let m = 0; d.plans.forEach((p, k) => { if (p.exact_map && p.exact_map.summary.max_excess_mm >"
+        " d.plans[m].exact_map.summary.max_excess_mm) m = k; }); return m; })()")
+    browser.evaluate("document.querySelector('#exact-panel .exact-plan[data-plan=\"%d\"]').click()" % most)
+    check(browser.evaluate("hybridctlReport.exactPlan") == most and browser.evaluate("hybridctlReport.visible['exact']"),
+          "flanged hub: choosing plan %d did not show its exact map" % (most + 1))
+    exact = browser.screenshot(os.path.join(screens, "flanged-hub-exact-plan-%d.png" % (most + 1)))
+    coloured = sum(1 for p in exact.crop(box).getdata() if abs(p[0] - p[2]) > 40)
+    check(coloured > 1000, "flanged hub: plan %d's exact map shows only %d pixels in the scale's colours" %
+          (most + 1, coloured))
+    browser.evaluate("hybridctlReport.setVisible('exact', false); hybridctlReport.setVisible('design', true)")
+    plain = browser.screenshot(os.path.join(screens, "flanged-hub-design.png"))
+    changed = changed_pixels(exact, plain, box)
+    check(changed > 2000, "flanged hub: the exact map and the plain design differ in only %d pixels" % changed)
+    figures = browser.evaluate("document.getElementById('exact-figures').innerText")
+    check("Largest excess" in figures and "Deepest gouge" in figures and "line " in figures,
+          "flanged hub: the exact figures do not name the largest excess and gouge with their lines: %r" % figures)
+    browser.evaluate("document.querySelector('#exact-panel .exact-plan[data-plan=\"1\"]').click()")
+    check(browser.evaluate("hybridctlReport.exactPlan") == 1 and browser.evaluate("hybridctlReport.visible['exact']"),
+          "flanged hub: choosing plan 2 did not show its exact map")
+    check(browser.evaluate("document.getElementById('view-caption').textContent").startswith("Plan 2 · exact"),
+          "flanged hub: the caption does not say plan 2's map is shown")
+
+
+def check_flanged_hub(browser, page, screens, stl_triangles):
     browser.open(page)
     box = check_common(browser, "flanged-hub", screens)
     plans = browser.evaluate("document.querySelectorAll('.plan').length")
     check(plans == 5, "flanged hub: %s plans shown, expected 5" % plans)
+    check_exact_map(browser, screens, stl_triangles)
     # The first action of plan 1 with a toolpath of several layers.
     card = browser.evaluate(
         "(() => { const d = JSON.parse(document.getElementById('report-data').textContent);"
@@ -226,6 +280,7 @@ def check_flanged_hub(browser, page, screens):
     action, layer_count = card
     check(browser.evaluate("getComputedStyle(document.getElementById('path-controls')).display !== 'none'"),
           "flanged hub: no layer slider shown")
+    check(browser.evaluate("hybridctlReport.visible['exact']") is False, "flanged hub: the exact map stays over the toolpath")
     all_layers = browser.screenshot(os.path.join(screens, "flanged-hub-toolpath-all-layers.png"))
     browser.evaluate("(() => { const s = document.getElementById('layer-slider'); s.value = 0;"
                      " s.dispatchEvent(new Event('input')); })()")
@@ -283,7 +338,8 @@ def main():
     browser = None
     try:
         browser = Browser(profile)
-        check_flanged_hub(browser, os.path.join(out, "flanged-hub/report.html"), screens)
+        check_flanged_hub(browser, os.path.join(out, "flanged-hub/report.html"), screens,
+                          stl_triangles(os.path.join(out, "flanged-hub/design.stl")))
         check_not_manufacturable(browser, os.path.join(out, "not-manufacturable/report.html"), screens)
     finally:
         if browser:

@@ -47,7 +47,12 @@ const Planned& planned() {
     options.top_k = 10;  // plan 9 deposits the hub from -Z and mills it
     const planner::PlanningResult r = planner::plan_part(mesh, "flanged-hub.stl", out.machine, options);
     const fs::path dir = fs::temp_directory_path() / ("hybridctl-replay-" + std::to_string(::getpid()));
-    planner::write_plan_directory(r, {"flanged-hub.stl", "hybrid-3axis.yaml", out.machine.name, ""}, dir);
+    // The STL copied into the directory (design.stl), as `plan` does: milling with flat
+    // tools finishes the walls on it (docs/toolpaths.md, "Wall finishing"), which the
+    // replays here judge on the voxels.
+    planner::write_plan_directory(r, {HYBRIDCTL_SOURCE_DIR "/examples/parts/flanged-hub.stl", "hybrid-3axis.yaml",
+                                      out.machine.name, ""},
+                                  dir);
     out.file = plan::read_plan_file(dir);
     fs::remove_all(dir);
     return out;

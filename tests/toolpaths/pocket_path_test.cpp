@@ -15,11 +15,15 @@
 
 #include <chrono>
 #include <cmath>
+#include <functional>
+#include <memory>
 #include <set>
 
 #include "toolpaths/setup_frame.hpp"
+#include "geometry/mesh.hpp"
 #include "geometry/morphology.hpp"
 #include "geometry/shapes.hpp"
+#include "geometry/voxelize.hpp"
 #include "planner/primitives/machine_primitives.hpp"
 #include "toolpath_oracles.hpp"
 
@@ -401,6 +405,181 @@ TEST(PocketPath, OtherSetupsMillInTheirWorkFrame) {
     if (m.kind == MoveKind::Feed && m.process_on) {
       EXPECT_GE(work_to_part(m.to, side.approach).x, 6 - 1e-9);
     }
+}
+
+// Closed meshes for wall finishing (a flat cutter on the design's real walls).
+using geometry::Triangle;
+
+void add_quad(std::vector<Triangle>& m, Vec3 a, Vec3 b, Vec3 c, Vec3 d) {
+  m.push_back({a, b, c});
+  m.push_back({a, c, d});
+}
+
+// A block with a rectangular pocket open at its top (pocket.max.z == outer.max.z).
+std::vector<Triangle> pocketed_block(Box3 o, Box3 p) {
+  std::vector<Triangle> m;
+  const double z0 = o.min.z, z1 = o.max.z, zf = p.min.z;
+  const Vec3 oc[4] = {{o.min.x, o.min.y, 0}, {o.max.x, o.min.y, 0}, {o.max.x, o.max.y, 0}, {o.min.x, o.max.y, 0}};
+  const Vec3 pc[4] = {{p.min.x, p.min.y, 0}, {p.max.x, p.min.y, 0}, {p.max.x, p.max.y, 0}, {p.min.x, p.max.y, 0}};
+  auto at = [](Vec3 v, double z) { return Vec3{v.x, v.y, z}; };
+  for (int i = 0; i < 4; ++i) {
+    const int j = (i + 1) % 4;
+    add_quad(m, at(oc[i], z0), at(oc[j], z0), at(oc[j], z1), at(oc[i], z1));  // outer sides
+    add_quad(m, at(pc[j], zf), at(pc[i], zf), at(pc[i], z1), at(pc[j], z1));  // pocket walls
+    add_quad(m, at(oc[i], z1), at(oc[j], z1), at(pc[j], z1), at(pc[i], z1));  // top, round the pocket
+  }
+  add_quad(m, at(oc[0], z0), at(oc[3], z0), at(oc[2], z0), at(oc[1], z0));  // bottom
+  add_quad(m, at(pc[0], zf), at(pc[1], zf), at(pc[2], zf), at(pc[3], zf));  // pocket floor
+  return m;
+}
+
+// A prism over a convex polygon, z0..z1.
+std::vector<Triangle> prism_mesh(const std::vector<Vec3>& poly, double z0, double z1) {
+  std::vector<Triangle> m;
+  const std::size_t n = poly.size();
+  auto at = [](Vec3 v, double z) { return Vec3{v.x, v.y, z}; };
+  for (std::size_t i = 0; i < n; ++i) add_quad(m, at(poly[i], z0), at(poly[(i + 1) % n], z0), at(poly[(i + 1) % n], z1), at(poly[i], z1));
+  for (std::size_t i = 1; i + 1 < n; ++i) {
+    m.push_back({at(poly[0], z0), at(poly[i + 1], z0), at(poly[i], z0)});
+    m.push_back({at(poly[0], z1), at(poly[i], z1), at(poly[i + 1], z1)});
+  }
+  return m;
+}
+
+std::vector<Vec3> rectangle_xy(Box3 b) { return {{b.min.x, b.min.y, 0}, {b.max.x, b.min.y, 0}, {b.max.x, b.max.y, 0}, {b.min.x, b.max.y, 0}}; }
+
+double distance_to_polygon(double x, double y, const std::vector<Vec3>& poly) {
+  bool in = false;
+  double d = 1e300;
+  for (std::size_t i = 0, n = poly.size(); i < n; ++i) {
+    const Vec3 a = poly[i], b = poly[(i + 1) % n];
+    if ((a.y > y) != (b.y > y) && a.x + (y - a.y) / (b.y - a.y) * (b.x - a.x) > x) in = !in;
+    const double dx = b.x - a.x, dy = b.y - a.y, l2 = dx * dx + dy * dy;
+    const double t = std::clamp(((x - a.x) * dx + (y - a.y) * dy) / l2, 0.0, 1.0);
+    d = std::min(d, std::hypot(x - a.x - t * dx, y - a.y - t * dy));
+  }
+  return in ? -d : d;
+}
+
+// The closest any tool position of the path comes to a wall (signed distance of the tip
+// from `wall` in XY, negative inside), over the positions whose cutter reaches heights in
+// (z_lo, z_hi): followed every 1/8 voxel. With `feeds_only`, only along cutting moves.
+double closest_approach(const Toolpath& p, const std::function<double(double, double)>& wall, double z_lo, double z_hi,
+                        bool feeds_only = false) {
+  double best = 1e300;
+  const auto starts = move_starts(p);
+  for (std::size_t i = 0; i < p.moves.size(); ++i) {
+    if (feeds_only && !(p.moves[i].kind == MoveKind::Feed && p.moves[i].process_on)) continue;
+    along(starts[i], p.moves[i].to, kLattice.voxel_size / 8, [&](Vec3 q) {
+      if (q.z < z_hi - 1e-9 && q.z > z_lo - 1e-9) best = std::min(best, wall(q.x, q.y));
+    });
+  }
+  return best;
+}
+
+// The tip polylines of the wall finishing passes: from each lead-in to its lead-out.
+std::vector<std::vector<Vec3>> finishing_passes(const Toolpath& p) {
+  std::vector<std::vector<Vec3>> out;
+  bool in = false;
+  for (const auto& m : p.moves) {
+    if (m.comment.find("finish lead-in") != std::string::npos) {
+      out.emplace_back();
+      in = true;
+    } else if (m.comment.find("finish lead-out") != std::string::npos && in) {
+      in = false;
+      continue;
+    }
+    if (in) out.back().push_back(m.to);
+  }
+  return out;
+}
+
+TEST(PocketPath, WallFinishingPutsAFlatCuttersSideOnThePocketsRealWalls) {
+  // Walls between voxel centres: the lattice alone keeps the cutter up to a voxel off them.
+  const Box3 outer{{0, 0, 0}, {24, 22, 8}}, hole{{4.2, 4.1, 3}, {19.9, 17.8, 8}};
+  const auto mesh = std::make_shared<const std::vector<Triangle>>(pocketed_block(outer, hole));
+  const Solid stock = box(outer);
+  const Solid design = geometry::voxelize(geometry::TriangleMesh{*mesh}, kLattice, "pocketed block");
+  const Solid roi = geometry::subtract(stock, design);
+  const auto tool = flat_4mm();
+  const double r = tool.diameter / 2;
+  PocketOptions on;
+  on.design = mesh;
+  on.design_voxels = &design;
+  PocketOptions off = on;
+  off.finish_walls = false;
+  const Toolpath p = pocket_path(roi, design, stock, tool, top_setup(), on);
+  const Toolpath q = pocket_path(roi, design, stock, tool, top_setup(), off);
+  for (const auto& w : p.warnings) EXPECT_EQ(w.find("wall finishing"), std::string::npos) << w;
+  const Replay rp = replay(p, stock, design, tool);
+  EXPECT_EQ(rp.gouges, 0);
+  EXPECT_EQ(rp.rapids_into_material, 0);
+  EXPECT_EQ(rp.plunges_into_material, 0);
+  // Below the block's top, no tool position ever has its cutter in the STL's solid (any
+  // move, roughing included), and the finishing passes put it on each wall within the
+  // chord tolerance (0.001) and the clearance (0.0002).
+  const std::vector<Vec3> pocket_xy = rectangle_xy(hole);
+  auto inside_pocket = [&](double x, double y) { return -distance_to_polygon(x, y, pocket_xy); };
+  EXPECT_GE(closest_approach(p, inside_pocket, 3, 8), r + 0.0002 - 1e-9);
+  for (const auto& [name, wall] : std::vector<std::pair<std::string, std::function<double(double, double)>>>{
+           {"x = 4.2", [](double x, double) { return x - 4.2; }},
+           {"x = 19.9", [](double x, double) { return 19.9 - x; }},
+           {"y = 4.1", [](double, double y) { return y - 4.1; }},
+           {"y = 17.8", [](double, double y) { return 17.8 - y; }}}) {
+    SCOPED_TRACE(name);
+    EXPECT_LE(closest_approach(p, wall, 3, 8, true), r + 0.0012 + 1e-9);
+  }
+  // Without the finishing, the lattice stays 0.15 mm off the wall at x = 19.9 (the nearest
+  // allowed tip is on the voxel centre 17.75).
+  EXPECT_NEAR(closest_approach(q, [](double x, double) { return 19.9 - x; }, 3, 8, true), r + 0.15, 1e-9);
+  // Climb milling inside a pocket: its passes run counter-clockwise.
+  const auto passes = finishing_passes(p);
+  ASSERT_FALSE(passes.empty());
+  for (const auto& pass : passes) {
+    double area = 0;
+    for (std::size_t i = 0; i + 1 < pass.size(); ++i) area += pass[i].x * pass[i + 1].y - pass[i + 1].x * pass[i].y;
+    EXPECT_GT(area, 0);
+  }
+  // What stays of the ROI on the voxels is no more than without the finishing.
+  const Replay rq = replay(q, stock, design, tool);
+  EXPECT_LE(geometry::intersect(rp.present, roi).voxel_count(), geometry::intersect(rq.present, roi).voxel_count());
+}
+
+TEST(PocketPath, WallFinishingKeepsOffWhatStaysThatIsNotDesign) {
+  // A 48-gon boss of radius 4.1 on a 2 mm base; east of it a rib of stock kept for a later
+  // action (not design): the pass round the boss must leave it, and still finish the rest.
+  std::vector<Vec3> gon;
+  for (int i = 0; i < 48; ++i)
+    gon.push_back({11 + 4.1 * std::cos(2 * M_PI * i / 48), 11 + 4.1 * std::sin(2 * M_PI * i / 48), 0});
+  auto parts = prism_mesh(rectangle_xy({{0, 0, 0}, {22, 22, 2}}), 0, 2);
+  const auto boss = prism_mesh(gon, 2, 7);
+  parts.insert(parts.end(), boss.begin(), boss.end());
+  const auto mesh = std::make_shared<const std::vector<Triangle>>(parts);
+  const Solid stock = box({{0, 0, 0}, {22, 22, 7}});
+  const Solid design = geometry::voxelize(geometry::TriangleMesh{*mesh}, kLattice, "boss");
+  const Solid rib = box({{14.5, 9, 2}, {22, 13, 7}});
+  const Solid keep = geometry::unite(design, rib);
+  const Solid roi = geometry::subtract(stock, keep);
+  const auto tool = flat_4mm();
+  const double r = tool.diameter / 2;
+  PocketOptions o;
+  o.design = mesh;  // the design's voxels made from it
+  const Toolpath p = pocket_path(roi, keep, stock, tool, top_setup(), o);
+  const Replay rp = replay(p, stock, keep, tool);
+  EXPECT_EQ(rp.gouges, 0) << "the rib is kept";
+  EXPECT_EQ(rp.rapids_into_material, 0);
+  EXPECT_EQ(rp.plunges_into_material, 0);
+  auto off_boss = [&](double x, double y) { return distance_to_polygon(x, y, gon); };
+  EXPECT_GE(closest_approach(p, off_boss, 2, 7), r + 0.0002 - 1e-9);
+  EXPECT_LE(closest_approach(p, off_boss, 2, 7, true), r + 0.0012 + 1e-9);
+  // Finishing passes run clockwise round the island and stay off the rib's side of it.
+  const auto passes = finishing_passes(p);
+  ASSERT_FALSE(passes.empty());
+  for (const auto& pass : passes) {
+    double area = 0;
+    for (std::size_t i = 0; i + 1 < pass.size(); ++i) area += pass[i].x * pass[i + 1].y - pass[i + 1].x * pass[i].y;
+    EXPECT_LT(area, 0);
+  }
 }
 
 TEST(PocketPath, NothingToRemoveGivesAnEmptyPathWithAWarning) {

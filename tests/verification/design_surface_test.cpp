@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "common/error.hpp"
 #include "verification_meshes.hpp"
@@ -34,6 +35,37 @@ TEST(DesignSurface, SamplesCoverTheAreaWithOutwardNormalsWhateverTheWinding) {
     EXPECT_NEAR(area, 2 * (10 * 8 + 10 * 6 + 8 * 6), 1e-9);
     EXPECT_NEAR(surface.area(), area, 1e-9);
     EXPECT_GE(surface.samples().size(), 376u);  // at least one per spacing^2
+  }
+}
+
+TEST(DesignSurface, EverySampleNamesTheFacetItWasCutFromAndTheFacetsShareItsArea) {
+  geometry::TriangleMesh mesh = box_mesh({0, 0, 0}, {10, 8, 6});
+  const std::size_t facets = mesh.triangles.size();
+  mesh.triangles.push_back(mesh.triangles.front());                             // repeated: cleaned away
+  mesh.triangles.push_back({geometry::Vec3{0, 0, 0}, {1, 0, 0}, {2, 0, 0}});  // no area: skipped
+  const DesignSurface surface(mesh, "box", spacing(0.5, 1));
+  ASSERT_EQ(surface.triangles().size(), facets);
+  std::vector<double> area(facets, 0);
+  for (const SurfaceSample& s : surface.samples()) {
+    ASSERT_LT(s.triangle, facets);
+    const geometry::Triangle& t = surface.triangles()[s.triangle];
+    // The sample lies on its facet: in its plane and inside its three edges.
+    const auto sub = [](geometry::Vec3 a, geometry::Vec3 b) { return geometry::Vec3{a.x - b.x, a.y - b.y, a.z - b.z}; };
+    const auto cross = [](geometry::Vec3 a, geometry::Vec3 b) {
+      return geometry::Vec3{a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+    };
+    const auto dot = [](geometry::Vec3 a, geometry::Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; };
+    const geometry::Vec3 n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+    EXPECT_NEAR(dot(sub(s.point, t[0]), n), 0, 1e-9);
+    for (int e = 0; e < 3; ++e) EXPECT_GE(dot(cross(sub(t[(e + 1) % 3], t[e]), sub(s.point, t[e])), n), -1e-9);
+    area[s.triangle] += s.area;
+  }
+  for (std::size_t i = 0; i < facets; ++i) {
+    const geometry::Triangle& t = surface.triangles()[i];
+    const double ax = t[1].x - t[0].x, ay = t[1].y - t[0].y, az = t[1].z - t[0].z;
+    const double bx = t[2].x - t[0].x, by = t[2].y - t[0].y, bz = t[2].z - t[0].z;
+    const double cx = ay * bz - az * by, cy = az * bx - ax * bz, cz = ax * by - ay * bx;
+    EXPECT_NEAR(area[i], 0.5 * std::sqrt(cx * cx + cy * cy + cz * cz), 1e-9) << "facet " << i;
   }
 }
 

@@ -35,7 +35,7 @@ TEST(PlanInMemory, EqualsThePlanReadBackFromItsDirectory) {
   options.top_k = 3;
   const PlanningResult result = plan_part(part, "flanged-hub.stl", machine, options);
   ASSERT_FALSE(result.plans.empty());
-  const ReportSources sources{"flanged-hub.stl", "hybrid-3axis.yaml", machine.name, machine_text};
+  const ReportSources sources{HYBRIDCTL_SOURCE_DIR "/examples/parts/flanged-hub.stl", "hybrid-3axis.yaml", machine.name, machine_text};
   const fs::path dir = fs::temp_directory_path() / ("hybridctl-plan-in-memory-" + std::to_string(::getpid()));
   write_plan_directory(result, sources, dir);
   const plan::PlanFile disk = plan::read_plan_file(dir);
@@ -94,7 +94,7 @@ TEST(PlanInMemory, RejectedCandidatesAreKeptWithTheirReasonsAndReadBack) {
   EXPECT_GE(result.plans[0].cost, unvalidated.plans[1].cost);
   EXPECT_EQ(offered, 4);
 
-  const ReportSources sources{"flanged-hub.stl", "hybrid-3axis.yaml", machine.name, machine_text};
+  const ReportSources sources{HYBRIDCTL_SOURCE_DIR "/examples/parts/flanged-hub.stl", "hybrid-3axis.yaml", machine.name, machine_text};
   const fs::path dir = fs::temp_directory_path() / ("hybridctl-plan-rejected-" + std::to_string(::getpid()));
   write_plan_directory(result, sources, dir);
   const plan::PlanFile disk = plan::read_plan_file(dir);
