@@ -5,6 +5,7 @@
 #include <iterator>
 #include <map>
 #include <mutex>
+#include <tuple>
 #include <vector>
 
 #include <CGAL/AABB_traits.h>
@@ -72,7 +73,7 @@ struct DesignSurface::Tree {
   std::vector<Triangle3> triangles;
   AabbTree tree;
   std::mutex frames_mutex;
-  std::map<config::Approach, std::unique_ptr<FrameIndex>> frames;
+  std::map<std::tuple<config::Approach, std::size_t, std::size_t>, std::unique_ptr<FrameIndex>> frames;
 };
 
 SamplingOptions sampling_for(double tolerance, double voxel) {
@@ -149,10 +150,10 @@ DesignSurface::~DesignSurface() = default;
 DesignSurface::DesignSurface(DesignSurface&&) noexcept = default;
 DesignSurface& DesignSurface::operator=(DesignSurface&&) noexcept = default;
 
-const FrameIndex& DesignSurface::frame(config::Approach approach) const {
+const FrameIndex& DesignSurface::frame(config::Approach approach, std::size_t part, std::size_t parts) const {
   const std::lock_guard<std::mutex> lock(tree_->frames_mutex);
-  std::unique_ptr<FrameIndex>& f = tree_->frames[approach];
-  if (!f) f = std::make_unique<FrameIndex>(samples_, approach);
+  std::unique_ptr<FrameIndex>& f = tree_->frames[{approach, part, parts}];
+  if (!f) f = std::make_unique<FrameIndex>(samples_, approach, part, parts);
   return *f;
 }
 

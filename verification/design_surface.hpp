@@ -60,8 +60,9 @@ class DesignSurface {
   // Distance from `p` to the nearest point of the surface, mm.
   double distance(const geometry::Vec3& p) const;
   // The samples' vectors in the work frame of a setup with `approach`, indexed for sweeps
-  // (verification/vector_index.hpp); made on first use and kept. Safe from any thread.
-  const FrameIndex& frame(config::Approach approach) const;
+  // (verification/vector_index.hpp): all of them, or a thread's share (`part` of `parts`);
+  // made on first use and kept. Safe from any thread.
+  const FrameIndex& frame(config::Approach approach, std::size_t part = 0, std::size_t parts = 1) const;
 
  private:
   struct Tree;

@@ -77,10 +77,10 @@ Vec3 along(const SurfaceSample& s, double t) {
 }
 
 // The start stock along a vector: the cubes of its voxels, exactly (the line's crossings
-// of the lattice planes cut it into pieces that lie in one voxel each).
+// of the lattice planes cut it into pieces that lie in one voxel each). The caller tells
+// an empty stock apart once (Solid::empty() scans the whole grid).
 Runs stock_runs(const geometry::Solid& stock, const SurfaceSample& s) {
   Runs runs;
-  if (stock.empty()) return runs;
   const geometry::Lattice& l = stock.lattice();
   const double t0 = -s.inward, t1 = s.outward;
   std::vector<double> cuts{t0, t1};
@@ -125,7 +125,8 @@ class Verifier {
   Verifier(const DesignSurface& surface, const config::Machine& machine, const geometry::Solid& stock)
       : surface_(surface), machine_(machine), runs_(surface.samples().size()) {
     ops_.push_back({});
-    for (std::size_t i = 0; i < runs_.size(); ++i) runs_[i] = stock_runs(stock, surface.samples()[i]);
+    if (!stock.empty())
+      for (std::size_t i = 0; i < runs_.size(); ++i) runs_[i] = stock_runs(stock, surface.samples()[i]);
     for (const config::CuttingTool& t : machine.tools)
       instruments_[t.number] = {completed_pieces(sim::pieces_of(instruments::cutter_of(t).cutting)), -1};
     for (std::size_t h = 0; h < machine.heads.size(); ++h)
@@ -146,17 +147,16 @@ class Verifier {
   }
 
   // Replays the recorded segments on the vectors, in program order for each vector. The
-  // vectors are independent: two halves go on two threads.
+  // vectors are independent: two halves go on two threads, each with its own index.
   void sweep() {
     tbb::parallel_for(0, kParts, [&](int part) {
       Runs scratch;
       const auto& samples = surface_.samples();
       for (const Step& step : steps_) {
-        const FrameIndex& index = surface_.frame(step.approach);
+        const FrameIndex& index = surface_.frame(step.approach, std::size_t(part), kParts);
         const bool cuts = step.instrument->head < 0;
         for (const sim::ConvexPiece& piece : step.instrument->pieces)
           index.for_each_near(swept_box(piece, step.segment, ceiling_), [&](std::uint32_t i) {
-            if (int(i % kParts) != part) return;
             Runs& runs = runs_[i];
             if (cuts && runs.empty()) return;  // nothing to cut
             const SurfaceSample& s = samples[i];
@@ -240,8 +240,6 @@ class Verifier {
     p.at_least = at_least;
     return p;
   }
-
-  const FrameIndex& frame(config::Approach approach) { return surface_.frame(approach); }
 
   const DesignSurface& surface_;
   const config::Machine& machine_;

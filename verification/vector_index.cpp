@@ -13,7 +13,8 @@ Vec3 along(const SurfaceSample& s, double t) {
 
 }  // namespace
 
-FrameIndex::FrameIndex(const std::vector<SurfaceSample>& samples, config::Approach approach) {
+FrameIndex::FrameIndex(const std::vector<SurfaceSample>& samples, config::Approach approach, std::size_t part,
+                       std::size_t parts) {
   points_.reserve(samples.size());
   normals_.reserve(samples.size());
   std::vector<geometry::Box3> boxes;
@@ -45,12 +46,14 @@ FrameIndex::FrameIndex(const std::vector<SurfaceSample>& samples, config::Approa
     const double cx = 0.5 * (b.min.x + b.max.x), cy = 0.5 * (b.min.y + b.max.y);
     fn(column(range(cx, cx, 0).first, range(cy, cy, 1).first));
   };
-  for (const geometry::Box3& b : boxes) each_column(b, [&](std::size_t c) { ++count[c + 1]; });
+  auto mine = [&](std::size_t i) { return i % parts == part; };
+  for (std::size_t i = 0; i < boxes.size(); ++i)
+    if (mine(i)) each_column(boxes[i], [&](std::size_t c) { ++count[c + 1]; });
   for (std::size_t c = 1; c < count.size(); ++c) count[c] += count[c - 1];
   start_ = count;
   entries_.resize(count.back());
   for (std::uint32_t i = 0; i < boxes.size(); ++i)
-    each_column(boxes[i], [&](std::size_t c) { entries_[count[c]++] = {boxes[i].min.z, boxes[i].max.z, boxes[i].min.x, boxes[i].max.x,
+    if (mine(i)) each_column(boxes[i], [&](std::size_t c) { entries_[count[c]++] = {boxes[i].min.z, boxes[i].max.z, boxes[i].min.x, boxes[i].max.x,
                                                                   boxes[i].min.y, boxes[i].max.y, i}; });
   for (std::size_t c = 0; c < columns; ++c)
     std::sort(entries_.begin() + start_[c], entries_.begin() + start_[c + 1],

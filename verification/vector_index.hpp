@@ -2,7 +2,10 @@
 // The vectors of a design surface's samples in one setup's work frame, found by the box a
 // sweep covers (verification/exact_deviation.cpp): binned in XY columns, and in each
 // column sorted by their lowest point, so that a sweep finds the vectors in its height
-// range by a binary search instead of visiting cells up the whole flute.
+// range by a binary search instead of visiting cells up the whole flute. A sweep on
+// several threads gives each its own share of the vectors (`part` of `parts`: the ones
+// whose index is part modulo parts), each share its own index, so that no thread visits
+// the vectors of another.
 
 #include <algorithm>
 #include <cmath>
@@ -18,7 +21,8 @@ namespace hybridctl::verification {
 
 class FrameIndex {
  public:
-  FrameIndex(const std::vector<SurfaceSample>& samples, config::Approach approach);
+  FrameIndex(const std::vector<SurfaceSample>& samples, config::Approach approach, std::size_t part = 0,
+             std::size_t parts = 1);
   const geometry::Vec3& point(std::size_t i) const { return points_[i]; }
   const geometry::Vec3& normal(std::size_t i) const { return normals_[i]; }
 
