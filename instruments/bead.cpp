@@ -1,5 +1,8 @@
 #include "instruments/bead.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace hybridctl::instruments {
 
 Bead bead_of(const config::AdditiveHead& head) {
@@ -9,6 +12,14 @@ Bead bead_of(const config::AdditiveHead& head) {
     bead.body.push_back({geometry::AxialSection::Kind::Cylinder, n.standoff, n.standoff + n.length, n.diameter / 2, 0, 0});
   }
   return bead;
+}
+
+double bead_half_width_at(const Bead& bead, double dz) {
+  if (!(dz >= 0) || dz > bead.height) return 0;
+  const double r = bead.width / 2, half = bead.height / 2;
+  if (bead.shape != config::BeadShape::Ellipsoid || dz <= half) return r;
+  const double u = (dz - half) / half;
+  return r * std::sqrt(std::max(0.0, 1 - u * u));
 }
 
 int head_tool_number(const config::AdditiveHead& head, int fallback) {

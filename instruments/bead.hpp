@@ -34,6 +34,14 @@ struct Bead {
 // support limits.
 Bead bead_of(const config::AdditiveHead& head);
 
+// The bead's half-width (mm) at `dz` above its programmed point (its bottom), as the
+// material simulation lays it (docs/simulation.md): an ellipsoid bead is as wide as its
+// widest line from its bottom up to its middle (molten metal wets what it is laid on) and
+// narrows as the ellipse above; a cylinder is as wide all the way up. 0 outside [0, height].
+// What a pass lays at a voxel centre that height above the layer's bottom reaches this far
+// sideways, and no farther.
+double bead_half_width_at(const Bead& bead, double dz);
+
 // The T number that selects a head: its tool_number when positive (the machine loader
 // always sets one), otherwise `fallback`.
 int head_tool_number(const config::AdditiveHead& head, int fallback);

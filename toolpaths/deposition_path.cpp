@@ -11,6 +11,7 @@
 #include "common/number_text.hpp"
 #include "instruments/bead.hpp"
 #include "instruments/support_rule.hpp"
+#include "toolpaths/contour_reach.hpp"
 #include "toolpaths/setup_frame.hpp"
 #include "toolpaths/slices.hpp"
 
@@ -28,9 +29,7 @@ constexpr double kLineNudge = 1e-7;
 // Warnings per kind before they are summarised.
 constexpr int kMaxWarningsPerKind = 20;
 
-struct Vec2 {
-  double x = 0, y = 0;
-};
+using Vec2 = Point2;
 
 std::string mm(double v) { return fixed_number(v, 3); }
 
@@ -156,18 +155,29 @@ RasterResult raster_layer(const SliceMask& region, const geometry::Lattice& latt
   return out;
 }
 
-// Contour chains: the boundary cells of the region shrunk by `inset`, as polylines.
-std::vector<Pass> contour_layer(const SliceMask& region, const geometry::Lattice& lattice, double inset,
-                                double min_length) {
+// Contour chains: the boundary cells of the region shrunk by `inset`, as polylines,
+// pulled out where the bead would not reach the region's outermost voxel centres
+// (toolpaths/contour_reach.hpp); `out_of_reach` counts the cells still missed.
+std::vector<Pass> contour_layer(const SliceMask& region, const SliceMask& wall, const geometry::Lattice& lattice,
+                                double inset, double min_length, EdgeReach reach, int& out_of_reach) {
   const double h = lattice.voxel_size;
   const SliceMask inner = shrink_by_disc(region, inset / h);
-  std::vector<Pass> out;
+  std::vector<std::vector<Vec2>> chains;
   for (const auto& chain : trace_chains(boundary_cells(inner))) {
-    Pass p;
+    std::vector<Vec2> points;
     double length = 0;
-    for (std::size_t i = 0; i < chain.size(); ++i) {
-      const Vec2 c{lattice.origin.x + (chain[i].x + 0.5) * h, lattice.origin.y + (chain[i].y + 0.5) * h};
-      if (i > 0) length += std::hypot(c.x - p.points.back().x, c.y - p.points.back().y);
+    for (const Cell& cell : chain) {
+      const Vec2 c{lattice.origin.x + (cell.x + 0.5) * h, lattice.origin.y + (cell.y + 0.5) * h};
+      if (!points.empty()) length += std::hypot(c.x - points.back().x, c.y - points.back().y);
+      points.push_back(c);
+    }
+    if (points.size() >= 2 && length >= min_length - 1e-9) chains.push_back(std::move(points));
+  }
+  out_of_reach = reach_edges(chains, region, inner, lattice, reach, &wall);
+  std::vector<Pass> out;
+  for (const auto& chain : chains) {
+    Pass p;
+    for (const Vec2& c : chain) {
       // Drop the middle point of three collinear ones.
       if (p.points.size() >= 2) {
         const Vec2 a = p.points[p.points.size() - 2], b = p.points.back();
@@ -177,7 +187,7 @@ std::vector<Pass> contour_layer(const SliceMask& region, const geometry::Lattice
       }
       p.points.push_back(c);
     }
-    if (p.points.size() >= 2 && length >= min_length - 1e-9) out.push_back(std::move(p));
+    out.push_back(std::move(p));
   }
   return out;
 }
@@ -214,7 +224,9 @@ class DepositionBuilder {
   SliceMask layer_region(const Solid& solid, double zb, int& k) const;
   void drop_blocked(SliceMask& region, int k, int layer, double zb);
   void drop_overhangs(SliceMask& region, int layer, double zb);
-  std::vector<Pass> passes_of(const SliceMask& region, const SliceMask& wall, int layer, double angle);
+  std::vector<Pass> passes_of(const SliceMask& region, const SliceMask& wall, int layer, double angle, double zb);
+  // How far sideways a pass lays material at every voxel centre of the band at zb.
+  double cover_of(double zb) const;
   void finish();
 
   double corridor_top(Vec2 a, Vec2 b) const;
@@ -242,10 +254,11 @@ class DepositionBuilder {
   double lh_ = 0, s_ = 0, w_ = 0, travel_ = 0, inset_ = 0, min_length_ = 0, support_gap_ = 0, reach_ = 0, gap_ = 0,
          corridor_ = 0, plate_z_ = 0, z0_ = 0, z_top_ = 0, safe_z_ = 0;
   std::vector<double> angles_;
+  instruments::Bead bead_;
   // Emission state.
   bool started_ = false;
   Vec3 at_{};
-  int warnings_overhang_ = 0, dropped_total_ = 0, warnings_uncounted_ = 0, body_skipped_ = 0;
+  int warnings_overhang_ = 0, dropped_total_ = 0, out_of_reach_total_ = 0, warnings_uncounted_ = 0, body_skipped_ = 0;
   double overhang_area_total_ = 0, uncounted_area_total_ = 0;
 };
 
@@ -290,6 +303,7 @@ void DepositionBuilder::take_parameters() {
   reach_ = options_.overhang_reach.value_or(std::min(w_ / 2, instruments::support_rule(head_.support, h_).reach(1) * h_));
   gap_ = std::max(0.0, options_.approach_gap);
   corridor_ = std::max(w_ / 2, head_.nozzle ? head_.nozzle->diameter / 2 : 0.0);
+  bead_ = instruments::bead_of(head_);
   angles_ = options_.raster_angles_deg.empty() ? std::vector<double>{0.0} : options_.raster_angles_deg;
 }
 
@@ -487,11 +501,27 @@ void DepositionBuilder::drop_overhangs(SliceMask& region, int layer, double zb) 
 }
 
 // The layer's passes in order: rasters, and the contour before or after them.
-std::vector<Pass> DepositionBuilder::passes_of(const SliceMask& region, const SliceMask& wall, int layer, double angle) {
+// The bead narrows above its middle (instruments::bead_half_width_at): the band's highest
+// voxel centre below the next layer's bottom is the one it reaches least far. A band
+// that holds no centre lays the voxel above it, which the next layer lays again lower in
+// its bead: that layer's contour answers for it.
+double DepositionBuilder::cover_of(double zb) const {
+  double cover = w_ / 2;
+  const int k_lo = int(std::ceil((zb - oz_) / h_ - 0.5 - 1e-9)), k_hi = int(std::ceil((zb + lh_ - oz_) / h_ - 0.5 - 1e-9)) - 1;
+  for (int k = k_lo; k <= k_hi; ++k) cover = std::min(cover, instruments::bead_half_width_at(bead_, oz_ + (k + 0.5) * h_ - zb));
+  return cover;
+}
+
+std::vector<Pass> DepositionBuilder::passes_of(const SliceMask& region, const SliceMask& wall, int layer, double angle,
+                                               double zb) {
   const bool reverse_start = (layer / int(angles_.size())) % 2 == 1;
   std::vector<Pass> contour;
   RasterResult infill;
-  if (options_.contour != ContourPass::None) contour = contour_layer(region, lattice_, inset_, min_length_);
+  if (options_.contour != ContourPass::None) {
+    int out_of_reach = 0;
+    contour = contour_layer(region, wall, lattice_, inset_, min_length_, {cover_of(zb), w_ / 2}, out_of_reach);
+    if (!contour.empty()) out_of_reach_total_ += out_of_reach;
+  }
   if (!contour.empty()) {
     infill = raster_layer(shrink_by_disc(region, s_ / h_), lattice_, angle, s_, min_length_, inset_, reverse_start);
   } else {
@@ -530,7 +560,7 @@ void DepositionBuilder::deposit_layer(int layer, double zb) {
   const bool check_body = counted_ && head_.nozzle;
   int counted_top = 0;
   const SliceMask counted_here = check_body ? layer_region(*counted_, zb, counted_top) : empty_mask_;
-  for (const Pass& p : passes_of(region, wall, layer, angle)) {
+  for (const Pass& p : passes_of(region, wall, layer, angle, zb)) {
     if (check_body && !touches(p, counted_here) && body_meets_material(p, zb)) {
       ++body_skipped_;
       continue;
@@ -565,6 +595,11 @@ void DepositionBuilder::finish() {
   if (body_skipped_ > 0)
     path_.warnings.push_back(std::to_string(body_skipped_) + " passes that earlier actions were to lay left out: the " +
                              "nozzle body over them would meet material beside them");
+  if (out_of_reach_total_ > 0)
+    // Counted at the band's highest voxel centre: lower voxels, where the bead is wider,
+    // may still be laid. Short: warnings become program comments.
+    path_.warnings.push_back(std::to_string(out_of_reach_total_) + " edge cells the contour may not reach without " +
+                             "laying beyond the region");
   if (dropped_total_ > 0)
     path_.warnings.push_back(std::to_string(dropped_total_) + " raster segments shorter than " + mm(min_length_) +
                              " mm dropped (narrow parts of the region stay unfilled)");

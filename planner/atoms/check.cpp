@@ -162,10 +162,12 @@ Verdict core_verdict(const PlanningProblem& p, const CoreProof& proof, const std
   v.outcome = Verdict::Outcome::NotManufacturable;
   v.decided_without_search = true;
   int design = 0;
+  std::vector<char> only_by_cutting;  // per violation, as built
   for (const int a : proof.core) {
     const AtomMeasures& m = measures[std::size_t(a)];
     ViolatingAtom va = located_atom(p, m, a, lattice);
     const bool in = p.atoms[std::size_t(a)].must_in, out = p.atoms[std::size_t(a)].must_out;
+    const bool cut_free = cleared_only_by_cutting(p, a);
     design += in;
     std::string names;
     for (std::size_t k = 0; k < va.primitives.size() && k < 4; ++k)
@@ -175,14 +177,43 @@ Verdict core_verdict(const PlanningProblem& p, const CoreProof& proof, const std
                      (in ? "of the design" : out ? "outside the design" : "in the planning band") + " around " +
                      format("(%.1f, %.1f, %.1f)", m.centroid.x, m.centroid.y, m.centroid.z) + " mm" +
                      (in ? " (must be made)" : out ? " (must be left empty)" : " (carries or blocks the others)") +
-                     (names.empty() ? ", in no primitive" : ", in " + names);
+                     (names.empty() ? ", in no primitive" : ", in " + names) +
+                     (cut_free ? "; no removal reaches it without cutting the design" : "");
     v.violations.push_back(std::move(va));
+    only_by_cutting.push_back(cut_free);
   }
-  // The atoms fewest primitives hold first: what the part cannot get (a channel's roof, a
-  // slot's edge) before the base it stands on.
-  std::sort(v.violations.begin(), v.violations.end(), [](const ViolatingAtom& x, const ViolatingAtom& y) {
-    return x.primitives.size() != y.primitives.size() ? x.primitives.size() < y.primitives.size() : x.volume > y.volume;
+  // First the air no removal clears without cutting the part (a closed channel, a corner
+  // no cutter gets into): what the proof is about. After it the design and the air a way
+  // around it would spoil, the largest first (the lid and walls, not a row of voxels along
+  // an edge that only shows what an undersized deposit leaves out), and the band's atoms
+  // last. Without such air, the atoms fewest primitives hold (a roof, a slot's edge) before
+  // the base they stand on.
+  const bool hearted = std::count(only_by_cutting.begin(), only_by_cutting.end(), 1) > 0;
+  std::vector<std::size_t> order(v.violations.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  const auto in_band = [&](std::size_t i) {
+    const AtomSpec& spec = p.atoms[std::size_t(v.violations[i].atom)];
+    return !spec.must_in && !spec.must_out;
+  };
+  std::sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) {
+    const ViolatingAtom &x = v.violations[i], &y = v.violations[j];
+    if (only_by_cutting[i] != only_by_cutting[j]) return only_by_cutting[i] > only_by_cutting[j];
+    if (hearted && in_band(i) != in_band(j)) return in_band(j);
+    if (hearted || x.primitives.size() == y.primitives.size()) return x.volume > y.volume;
+    return x.primitives.size() < y.primitives.size();
   });
+  std::vector<ViolatingAtom> sorted;
+  std::string heart;
+  int hearts = 0;
+  for (const std::size_t i : order) {
+    if (only_by_cutting[i]) {
+      const ViolatingAtom& x = v.violations[i];
+      heart += std::string(hearts++ ? "; " : "") + "a " + format("%.3g", x.volume) + " mm\u00B3 region around " +
+               format("(%.1f, %.1f, %.1f)", x.centroid.x, x.centroid.y, x.centroid.z) + " mm";
+    }
+    sorted.push_back(std::move(v.violations[i]));
+  }
+  v.violations = std::move(sorted);
   v.summary = "no sequence of the " + std::to_string(p.primitives.size()) +
               " primitives gets these " + std::to_string(proof.core.size()) + " atoms right together (" +
               std::to_string(design) + " of the design), whatever the other atoms do: deposits cannot reach under "
@@ -191,6 +222,9 @@ Verdict core_verdict(const PlanningProblem& p, const CoreProof& proof, const std
               std::to_string(proof.joined[1]) + " a first layer with nothing under it, " + std::to_string(proof.joined[2]) +
               " were wrong at the end of a plan; proven over " + std::to_string(proof.states) + " states of " +
               std::to_string(proof.rounds) + " projections)";
+  if (hearts > 0)
+    v.summary += ". At its heart, air that a raw stock holds and no removal clears without cutting the design, "
+                 "which would then have to be made again: " + heart;
   return v;
 }
 

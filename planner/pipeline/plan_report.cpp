@@ -209,6 +209,34 @@ json stock_starts_json(const PlanningResult& r) {
   return out;
 }
 
+// The verdict's atoms as `plan` lists them: at most ten; of a proof's atoms, those that
+// must be made or left empty when there are any: the band's only carry or block the
+// others, a voxel layer along a face or an edge rather than a feature of the part
+// (plan.json has them all).
+std::string violations_text(const PlanningResult& r) {
+  std::ostringstream os;
+  const bool proof = r.core_proof.outcome == CoreProof::Outcome::Proven && !r.verdict.manufacturable();
+  std::vector<const ViolatingAtom*> listed;
+  std::size_t band = 0;
+  for (const ViolatingAtom& v : r.verdict.violations) {
+    const std::size_t a = std::size_t(v.atom);
+    const bool in_band = proof && a < r.problem.atoms.size() && !r.problem.atoms[a].must_in && !r.problem.atoms[a].must_out;
+    band += in_band;
+    if (!in_band) listed.push_back(&v);
+  }
+  if (listed.empty()) {
+    band = 0;
+    for (const ViolatingAtom& v : r.verdict.violations) listed.push_back(&v);
+  }
+  const std::size_t shown = std::min<std::size_t>(listed.size(), 10);
+  for (std::size_t i = 0; i < shown; ++i) os << "  - " << listed[i]->description << "\n";
+  if (r.verdict.violations.size() > shown)
+    os << "  ... and " << r.verdict.violations.size() - shown << " more in plan.json"
+       << (band > 0 ? " (" + std::to_string(band) + " of them in the planning band, carrying or blocking the others)" : "")
+       << "\n";
+  return os.str();
+}
+
 // One line per candidate that failed when executed, with its first reasons.
 std::string rejected_summary(const PlanningResult& r) {
   std::ostringstream os;
@@ -524,9 +552,7 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
                                                                 : "NOT manufacturable")
      << ": " << r.verdict.summary
      << "\n";
-  const std::size_t shown = std::min<std::size_t>(r.verdict.violations.size(), 10);
-  for (std::size_t i = 0; i < shown; ++i) os << "  - " << r.verdict.violations[i].description << "\n";
-  if (r.verdict.violations.size() > shown) os << "  ... and " << r.verdict.violations.size() - shown << " more in plan.json\n";
+  os << violations_text(r);
   os << stock_starts_text(r);
   if (r.validated) os << rejected_summary(r);
   if (!r.plans.empty()) {

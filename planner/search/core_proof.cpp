@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <tuple>
 
 #include "planner/search/steps.hpp"
 
@@ -306,11 +307,18 @@ Explanation why_refused(const PlanningProblem& p, const PrimitiveSpec& prim, con
       const int atom = int(w * 64) + std::countr_zero(b);
       if (prim.blocked_by && prim.blocked_by->meets(std::size_t(atom), s)) {
         const auto& blockers = (*prim.blocked_by)[std::size_t(atom)].words();
-        int blocker = -1;  // a present one, in S when one is
+        // A present one, in S when one is, else one that must be made or left empty, the
+        // largest: the body of the part in the head's way rather than a row of voxels
+        // along one of its edges, which would join S only to stand for it (docs/search.md).
+        int blocker = -1;
+        const auto rank = [&](int x) {
+          const AtomSpec& spec = p.atoms[std::size_t(x)];
+          return std::tuple{core.has[std::size_t(x)] != 0, spec.must_in || spec.must_out, spec.volume};
+        };
         for (std::size_t v = 0; v < blockers.size(); ++v)
           for (std::uint64_t hit = blockers[v] & s[v]; hit; hit &= hit - 1) {
             const int x = int(v * 64) + std::countr_zero(hit);
-            if (blocker < 0 || (core.has[std::size_t(x)] && !core.has[std::size_t(blocker)])) blocker = x;
+            if (blocker < 0 || rank(x) > rank(blocker)) blocker = x;
           }
         consider({{atom, blocker}, {}, CoreProof::Why::OutOfReach});
       }
@@ -363,7 +371,81 @@ Replay replay(const PlanningProblem& p, const std::vector<int>& sequence, const 
   return r;
 }
 
+// Whether no projected plan gets every atom of `core` right: a proof on its own.
+// Limit when the search passes `max_states` (counted in `states`).
+Search search_core(const PlanningProblem& p, const Core& core, const CoreProofLimits& limits, std::int64_t& states) {
+  std::vector<int> sequence;
+  const std::size_t n = core.size();
+  return n <= 64    ? search_projection(project<1>(p, core), limits, states, sequence)
+         : n <= 128 ? search_projection(project<2>(p, core), limits, states, sequence)
+         : n <= 256 ? search_projection(project<4>(p, core), limits, states, sequence)
+                    : search_projection(project<8>(p, core), limits, states, sequence);
+}
+
+// S as the refinement leaves it holds every atom that refuted some projected plan on the
+// way, many of them needed by none of the later ones: a row of voxels along an edge that
+// an undersized deposit leaves out, a blocker of a deposit that a later atom rules out
+// anyway. The verdict names S's atoms, so each is dropped in turn where the smaller S
+// still proves: what is left are atoms the proof needs, every one (none of them can go).
+// The band's atoms are tried first (they only carry or block), then the smallest, and
+// air that only a cut into the design clears last, so that what stays is rather what the
+// part cannot get than a voxel layer along its faces. Each drop is a proof on its own, so
+// running out of `limits.minimise_states` (or being stopped) leaves a proof too, a larger one.
+void minimise(const PlanningProblem& p, Core& core, const CoreProofLimits& given, std::int64_t& states) {
+  std::vector<std::pair<std::tuple<bool, bool, double>, int>> keyed;
+  for (const int a : core.atoms) {
+    const AtomSpec& spec = p.atoms[std::size_t(a)];
+    keyed.push_back({{cleared_only_by_cutting(p, a), spec.must_in || spec.must_out, spec.volume}, a});
+  }
+  std::stable_sort(keyed.begin(), keyed.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+  std::vector<int> order;
+  for (const auto& [key, a] : keyed) order.push_back(a);
+  CoreProofLimits limits = given;
+  limits.max_states = given.minimise_states;
+  std::int64_t spent = 0;
+  for (const int a : order) {
+    if (core.atoms.size() <= 1) break;
+    Core smaller = core;
+    std::erase(smaller.atoms, a);
+    smaller.has[std::size_t(a)] = 0;
+    std::int64_t tried = spent;
+    const Search s = search_core(p, smaller, limits, tried);
+    states += tried - spent;
+    spent = tried;
+    if (s == Search::Limit) return;
+    if (s == Search::NoPlan) core = std::move(smaller);
+  }
+}
+
 }  // namespace
+
+bool projection_refutes(const PlanningProblem& p, const std::vector<int>& atoms, const std::vector<AtomSet>& groups,
+                        std::int64_t max_states) {
+  Core core;
+  core.has.assign(p.atoms.size(), 0);
+  for (const int a : atoms)
+    if (!core.has[std::size_t(a)]) core.atoms.push_back(a), core.has[std::size_t(a)] = 1;
+  core.groups = groups;
+  if (core.size() > std::size_t(64 * kCoreWords)) return false;
+  CoreProofLimits limits;
+  limits.max_states = max_states;
+  std::int64_t states = 0;
+  return search_core(p, core, limits, states) == Search::NoPlan;
+}
+
+bool cleared_only_by_cutting(const PlanningProblem& p, int atom) {
+  if (!p.atoms[std::size_t(atom)].must_out) return false;
+  AtomSet design(int(p.atoms.size()));
+  for (std::size_t a = 0; a < p.atoms.size(); ++a)
+    if (p.atoms[a].must_in) design.set(int(a));
+  bool in_stock = false;
+  for (const PrimitiveSpec& prim : p.primitives) {
+    if (!prim.atoms.test(atom)) continue;
+    if (prim.mode == Mode::Additive) in_stock = in_stock || prim.raw_stock;
+    else if (!meets(prim.atoms, design, AtomSet{})) return false;
+  }
+  return in_stock;
+}
 
 CoreProof prove_by_core(const PlanningProblem& p, const CoreProofLimits& limits) {
   CoreProof proof;
@@ -380,7 +462,10 @@ CoreProof prove_by_core(const PlanningProblem& p, const CoreProofLimits& limits)
     if (found == Search::Limit) return proof;
     if (found == Search::NoPlan) {
       proof.outcome = CoreProof::Outcome::Proven;
+      proof.found = int(core.atoms.size());
+      minimise(p, core, limits, proof.minimising_states);
       proof.core = core.atoms;
+      proof.groups = core.groups;
       std::sort(proof.core.begin(), proof.core.end());
       return proof;
     }

@@ -185,20 +185,6 @@ TEST_F(Cli, TheOverhangOnTheBAxisMachineIsProvenImpossibleBeforeAnySearch) {
   EXPECT_NE(json.find("\"violations\": [\n"), std::string::npos);
 }
 
-// The slots on the B-axis machine at its own tolerance (0.3 mm, under the 0.5 mm voxel):
-// no cutter fits a slot, so the block is deposited round them. With the tolerance as the
-// voxels' band, the voxels at the top corners beside the slots, which a bead rounds by a
-// voxel, made the part "NOT manufacturable" over 0.125 mm^3 regions; within a band of a
-// voxel they are not a verdict, and the deposit is judged where it matters, on the STL:
-// its faces left as deposited stand out beyond 0.3 mm with the head's accuracy.
-TEST_F(Cli, TheSlotsOnTheBAxisMachineAreJudgedOnTheStlNotRefusedOverCornerVoxels) {
-  const Outcome r = run({"plan", kParts + "slots.stl", "--machine", kBAxisMachine, "-o", (dir_ / "plan").string()});
-  EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
-  EXPECT_EQ(r.out.find("verdict     NOT manufacturable"), std::string::npos) << r.out;
-  EXPECT_EQ(r.out.find("region of the design around (15.8, 0.2, 19.8) mm"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("(exact verification, tolerance 0.3 mm, as deposited)"), std::string::npos) << r.out;
-}
-
 // A tube on a plate on the B-axis machine, with a tolerance of one voxel: the bore's edge
 // with the plate is a sharp concave ring whose voxels a cutter's sweep on the grid misses
 // here and there, so the atom kept clear there is one beside it that the 12 mm flat
@@ -209,28 +195,6 @@ TEST_F(Cli, TheTubeOnAPlateIsMilledFromTheBlockOnTheBAxisMachineAtAToleranceOfAV
   EXPECT_NE(r.out.find("plans       3 ("), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("  1. ((((P2 \u2212 "), std::string::npos) << r.out;  // from the block
   EXPECT_NE(r.out.find("proven optimal"), std::string::npos) << r.out;
-}
-
-// The same tube at the B-axis machine's own tolerance, 0.3 mm, under a voxel: the voxels
-// are judged within a band of a voxel (plan/planning_band.hpp), the part against the STL.
-//
-// Against the STL the roughing's tips on voxel centres used to bite into the tube's round
-// wall between the voxel centres they spare, 0.43 mm deep (exact verification found it,
-// docs/verification.md; the voxels cannot), and every plan was refused. The flat cutters
-// now keep off the STL's real walls and finish them on it (docs/toolpaths.md, "Wall
-// finishing"): the block's plan is offered, and what is left off the surface is the 10 mm
-// bull nose's (action 4: no wall finishing for bull noses yet), within the 0.3 mm. (Its
-// lowest cut used to sit on a voxel centre 0.25 mm above the plate's bottom and leave the
-// block's margin there as a lip; the floor is now cut at its real height.)
-TEST_F(Cli, TheTubeOnAPlateAtTheMachinesToleranceIsMilledFromTheBlockWithItsWallsFinished) {
-  const Outcome r = run({"plan", kParts + "tube-plate.stl", "--machine", kBAxisMachine});
-  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
-  EXPECT_NE(r.out.find("  1. ((((P2 \u2212 "), std::string::npos) << r.out;  // from the block
-  EXPECT_EQ(r.out.find("exact_gouge: action 2"), std::string::npos) << r.out;  // the rougher's bite is gone
-  EXPECT_NE(r.out.find("exact:     excess 0.249 mm at (25.01, 32.25, 29.25) by action 4 (line "), std::string::npos)
-      << r.out;
-  EXPECT_NE(r.out.find("gouge 0.216 mm at (20.21, 18.83, 29.78) by action 4 (line "), std::string::npos) << r.out;
-  EXPECT_EQ(r.out.find("at least"), std::string::npos) << r.out;  // no lip of the margin
 }
 
 // A wall leaning 30 degrees on hybrid-3axis, deposited on its milled base: each layer's
@@ -271,75 +235,6 @@ TEST_F(Cli, PlansTheFlangedHubAndWritesPlanJsonWithValidPlans) {
   EXPECT_TRUE(fs::exists(dir_ / "plan" / "plans" / "plan-1.vdb"));
   // Planning again over the earlier output replaces it.
   EXPECT_EQ(run({"plan", "--no-validate", kFlangedHub, "--machine", kMachine, "--voxel", "1", "--top", "2", "-o", (dir_ / "plan").string()}).exit_code, 0);
-}
-
-// A block with a closed channel whose pointed roof builds without support: every plan
-// offered mills the block up to the channel's floor and deposits only the band above it
-// (docs/bands.md), and each one, exported and run on its own simulated controller from the
-// raw stock, makes the part within tolerance both ways with no alarm.
-// At 0.8 mm: the deposited band's faces stay as deposited, within the powder head's
-// 0.25 mm of the modelled beads, which the machine's 0.5 mm does not allow
-// (docs/verification.md).
-TEST_F(Cli, EveryPlanOfTheArchChannelBlockMillsToTheChannelFloorAndRunsWithinTolerance) {
-  const Outcome r = run({"dry-run", std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/arch-channel-block.stl", "--machine",
-                         kMachine, "--tolerance", "0.8", "--all", "-o", (dir_ / "dry").string()});
-  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
-  EXPECT_NE(r.out.find("dry-run     5 of 5 plans ran to the end with no alarm, within tolerance both ways"), std::string::npos)
-      << r.out;
-  // The band's milling primitive is in every plan: "P19 ... down to z = 22 mm".
-  const std::regex milled("\\n  (P[0-9]+) +SM-max T1 \\(10 mm flat rougher\\) from \\+Z \\(top\\), down to z = 22 mm");
-  std::smatch m;
-  ASSERT_TRUE(std::regex_search(r.out, m, milled)) << r.out;
-  const std::string band = m[1];
-  std::size_t plans = 0;
-  const std::regex plan_line("\nplan [0-9]+ +(\\(.*)  cost");
-  for (std::sregex_iterator it(r.out.begin(), r.out.end(), plan_line), end; it != end; ++it, ++plans)
-    EXPECT_NE((*it)[1].str().find(band + ")"), std::string::npos) << (*it)[1];
-  EXPECT_EQ(plans, 5u) << r.out;
-}
-
-// dry-run plans as `plan` does, with its tolerance and reuse: the tolerance asked for is
-// the one planned with and the one the part as built is judged against.
-TEST_F(Cli, DryRunPlansAndJudgesWithTheToleranceAskedFor) {
-  const std::string fins = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/fins.stl";
-  const Outcome r = run({"dry-run", fins, "--machine", kMachine, "--tolerance", "0.75", "--reuse", "2", "-o",
-                         (dir_ / "dry").string()});
-  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
-  EXPECT_NE(r.out.find("), tolerance 0.75 mm\n"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("within tolerance (0.75 mm)"), std::string::npos) << r.out;
-  const std::string json = slurp(dir_ / "dry" / "plan" / "plan.json");
-  EXPECT_NE(json.find("\"max_uses\": 2"), std::string::npos);
-  EXPECT_NE(json.find("\"tolerance\": 0.75"), std::string::npos);
-  EXPECT_EQ(run({"dry-run", fins, "--machine", kMachine, "--tolerance", "-1"}).exit_code, 2);
-  EXPECT_EQ(run({"dry-run", fins, "--machine", kMachine, "--reuse", "0"}).exit_code, 2);
-}
-
-// A repair (issue 16): the worn copy of the flanged hub (2.5 mm gone from half of the
-// flange's top) given as the stock. Every plan starts from it and deposits only what it
-// lacks; one deposits the neighbourhood of the missing region with overfill and mills the
-// top back flat, and every plan offered, run from the worn part on its own simulated
-// controller, makes the hub within tolerance both ways with no alarm.
-TEST_F(Cli, AWornHubIsRepairedByDepositingOnlyWhatItLacksAndEveryPlanRunsWithinTolerance) {
-  const std::string source = HYBRIDCTL_SOURCE_DIR;
-  // At 0.7 mm: the repaired faces stay as deposited, within the powder head's 0.25 mm of
-  // the modelled beads, which 0.5 mm does not allow (docs/verification.md).
-  const Outcome r = run({"dry-run", kFlangedHub, "--machine", kMachine, "--voxel", "0.5", "--tolerance", "0.7", "--stock",
-                         source + "/examples/parts/flanged-hub-worn.stl", "--all", "-o", (dir_ / "dry").string()});
-  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
-  EXPECT_NE(r.out.find("dry-run     5 of 5 plans ran to the end with no alarm, within tolerance both ways"), std::string::npos)
-      << r.out;
-  // "  3. (((P1 ∪ P2) ∪ P17) − P6)": the stock, the deposit near the missing region, a removal.
-  const std::regex local("\\n  (P[0-9]+) +O-AM ded from \\+Z \\(top\\), near the missing 2454 mm");
-  std::smatch m;
-  ASSERT_TRUE(std::regex_search(r.out, m, local)) << r.out;
-  const std::regex repair("\\n  [0-9]\\. \\(+P1 [^\\n]*∪ " + std::string(m[1]) + "\\) − P[0-9]+\\)  cost");
-  EXPECT_TRUE(std::regex_search(r.out, repair)) << r.out;
-  // Every action after the stock deposits at most the missing 2,454 mm³ and its overfill.
-  const std::regex deposit("\\n     [0-9]\\) P[0-9]+ +[UO]-AM [^\\n]* deposit +([0-9.]+) mm");
-  int deposits = 0;
-  for (auto it = std::sregex_iterator(r.out.begin(), r.out.end(), deposit); it != std::sregex_iterator(); ++it, ++deposits)
-    EXPECT_LT(std::stod((*it)[1]), 2454 * 1.2) << it->str();
-  EXPECT_GE(deposits, 5);
 }
 
 // The bracket's horizontal hole has a roof that no deposit from +Z holds up (it overhangs

@@ -89,25 +89,15 @@ class Run : public ::testing::Test {
     fs::remove_all(dir_);
   }
 
-  // The flanged hub planned once at 0.5 mm into DIR/plan (shared by the tests of one
-  // process, removed when it exits). Three plans, each proven by execution: the raw plate
-  // milled from below, the part turned over by hand (a program stop), then milled from above;
-  // the third mills with T1, then T2. (The bracket has no plan on this machine: the roof of its
-  // horizontal hole can be neither deposited nor milled from above or below.)
+  // The flanged hub planned once at 0.5 mm for every test (the ctest fixture
+  // Fixture.PlanFlangedHub, tests/CMakeLists.txt), read-only. Three plans, each proven by
+  // execution: the raw plate milled from below, the part turned over by hand (a program
+  // stop), then milled from above; the third mills with T1, then T2. (The bracket has no
+  // plan on this machine: the roof of its horizontal hole can be neither deposited nor
+  // milled from above or below.)
   static fs::path plan() {
-    struct PlanDir {
-      fs::path dir = fs::temp_directory_path() / ("hybridctl-run-plan-" + std::to_string(::getpid()));
-      ~PlanDir() { fs::remove_all(dir); }
-    };
-    static const PlanDir plan_dir;
-    static const fs::path p = [] {
-      const fs::path d = plan_dir.dir;
-      const std::string cmd = command({"plan", (kSource / "examples/parts/flanged-hub.stl").string(), "--machine", kMachine,
-                                       "--voxel", "0.5", "--top", "3", "-o", (d / "plan").string()}) +
-                              " >/dev/null 2>&1";
-      EXPECT_EQ(std::system(cmd.c_str()), 0);
-      return d / "plan" / "plan.json";
-    }();
+    const fs::path p = fs::path(HYBRIDCTL_HUB_PLAN) / "plan.json";
+    EXPECT_TRUE(fs::exists(p)) << p << ": not planned; run these tests with ctest, whose fixture Fixture.PlanFlangedHub plans it";
     return p;
   }
 

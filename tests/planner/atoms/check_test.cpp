@@ -141,5 +141,56 @@ TEST(Check, ADesignAtomThatEveryDepositLeavesOnlyForRemovalsCuttingIntoItIsRefus
   EXPECT_TRUE(yes.violations.empty());
 }
 
+// A proof's verdict names first the air a raw stock holds that every removal reaching it
+// cuts design with it, and says so: a channel under a lid, cleared only through the lid,
+// which no deposit lays again over the channel (laid first, on the plate, it would lack
+// the wall). Then the design around it, the largest first.
+TEST(Check, AProofsVerdictNamesFirstTheAirOnlyACutIntoTheDesignClears) {
+  enum { Lid, Channel, Wall, Atoms };
+  PlanningProblem p;
+  p.atoms = {{20, true, false}, {30, false, true}, {100, true, false}};
+  const auto primitive = [](std::string name, Mode mode, std::initializer_list<int> held) {
+    PrimitiveSpec s;
+    s.name = std::move(name);
+    s.mode = mode;
+    s.atoms = AtomSet(Atoms);
+    for (int a : held) s.atoms.set(a);
+    return s;
+  };
+  p.primitives = {primitive("P1", Mode::Additive, {Lid, Channel, Wall}), primitive("P2", Mode::Subtractive, {Lid, Channel}),
+                  primitive("P3", Mode::Additive, {Lid})};
+  p.primitives[0].raw_stock = true;
+  auto footing = std::make_shared<DepositFooting>();
+  footing->kind = {DepositFooting::NeedsCarrier, DepositFooting::OnPlate, DepositFooting::OnPlate};
+  std::vector<AtomSet> carriers(Atoms, AtomSet(Atoms));
+  carriers[Lid].set(Channel);
+  footing->carriers = AtomRelation(std::move(carriers));
+  p.primitives[2].footing = footing;
+  std::vector<AtomMeasures> measures(Atoms);
+  const Vec3 centroids[Atoms] = {{25, 15, 22}, {25, 15, 16}, {25, 5, 10}};
+  for (int a = 0; a < Atoms; ++a) {
+    measures[std::size_t(a)].code = AtomSet(int(p.primitives.size()));
+    for (int i = 0; i < int(p.primitives.size()); ++i) measures[std::size_t(a)].code.set(i, p.primitives[std::size_t(i)].atoms.test(a));
+    measures[std::size_t(a)].volume = p.atoms[std::size_t(a)].volume;
+    measures[std::size_t(a)].centroid = centroids[a];
+  }
+  const CoreProof proof = prove_by_core(p);
+  ASSERT_EQ(proof.outcome, CoreProof::Outcome::Proven);
+  const Verdict v = core_verdict(p, proof, measures, kUnit);
+  ASSERT_EQ(v.violations.size(), 3u);
+  EXPECT_EQ(v.violations[0].atom, int(Channel));
+  EXPECT_NE(v.violations[0].description.find("(must be left empty), in P1, P2; no removal reaches it without cutting the design"),
+            std::string::npos)
+      << v.violations[0].description;
+  EXPECT_EQ(v.violations[1].atom, int(Wall));
+  EXPECT_EQ(v.violations[2].atom, int(Lid));
+  for (std::size_t i = 1; i < 3; ++i)
+    EXPECT_EQ(v.violations[i].description.find("without cutting"), std::string::npos) << v.violations[i].description;
+  EXPECT_NE(v.summary.find("At its heart, air that a raw stock holds and no removal clears without cutting the design, "
+                           "which would then have to be made again: a 30 mm\u00B3 region around (25.0, 15.0, 16.0) mm"),
+            std::string::npos)
+      << v.summary;
+}
+
 }  // namespace
 }  // namespace hybridctl::planner

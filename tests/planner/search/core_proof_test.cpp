@@ -136,6 +136,44 @@ TEST(CoreProof, AProofThatDoesNotFitItsBudgetSaysUnknown) {
   EXPECT_EQ(prove_by_core(channel.p, limits).outcome, CoreProof::Outcome::Unknown);
 }
 
+// A random instance with reach and footing, more atoms than primitives; with a raw stock
+// on odd trials.
+PlanningProblem random_instance(std::mt19937& rng, int trial) {
+  const int atoms = 4 + int(rng() % 9), n = 4 + int(rng() % 7);
+  PlanningProblem p;
+  p.max_uses = 8;
+  p.start_from_stock = trial % 2 == 1;
+  for (int a = 0; a < atoms; ++a) {
+    const unsigned c = rng() % 5;  // must-in 2 in 5, must-out 1 in 5
+    p.atoms.push_back({1.0 + rng() % 10, c < 2, c == 2});
+  }
+  for (int i = 0; i < n; ++i) {
+    PrimitiveSpec s = primitive("P" + std::to_string(i), i == 0 || rng() % 3 ? Mode::Additive : Mode::Subtractive, atoms, {});
+    for (int a = 0; a < atoms; ++a)
+      if (rng() % 2 || (i == 0 && p.start_from_stock)) s.atoms.set(a);
+    s.raw_stock = i == 0 && p.start_from_stock;  // then every later deposit needs footing
+    if (s.mode == Mode::Additive && rng() % 2) {
+      std::vector<AtomSet> over(std::size_t(atoms), AtomSet{atoms});
+      for (auto& o : over)
+        if (rng() % 3 == 0) o.set(int(rng() % unsigned(atoms)));
+      s.blocked_by = std::make_shared<const AtomRelation>(std::move(over));
+    }
+    if (s.mode == Mode::Additive && rng() % 2) {
+      auto footing = std::make_shared<DepositFooting>();
+      std::vector<AtomSet> carriers;
+      for (int a = 0; a < atoms; ++a) {
+        footing->kind.push_back(rng() % 3 == 0 ? DepositFooting::NeedsCarrier : DepositFooting::OnPlate);
+        carriers.emplace_back(atoms);
+        for (int k = 0, m = 1 + int(rng() % 4); k < m; ++k) carriers.back().set(int(rng() % unsigned(atoms)));
+      }
+      footing->carriers = AtomRelation(std::move(carriers));
+      s.footing = footing;
+    }
+    p.primitives.push_back(std::move(s));
+  }
+  return p;
+}
+
 // Random instances with reach and footing, more atoms than primitives: every proof is
 // confirmed by the complete exploration of the whole problem, and every plan found makes
 // the part.
@@ -143,38 +181,7 @@ TEST(CoreProof, AgreesWithTheExhaustiveExplorationOnRandomInstances) {
   std::mt19937 rng(2024);
   int proven = 0, feasible = 0;
   for (int trial = 0; trial < 1000; ++trial) {
-    const int atoms = 4 + int(rng() % 9), n = 4 + int(rng() % 7);
-    PlanningProblem p;
-    p.max_uses = 8;
-    p.start_from_stock = trial % 2 == 1;
-    for (int a = 0; a < atoms; ++a) {
-      const unsigned c = rng() % 5;  // must-in 2 in 5, must-out 1 in 5
-      p.atoms.push_back({1.0 + rng() % 10, c < 2, c == 2});
-    }
-    for (int i = 0; i < n; ++i) {
-      PrimitiveSpec s = primitive("P" + std::to_string(i), i == 0 || rng() % 3 ? Mode::Additive : Mode::Subtractive, atoms, {});
-      for (int a = 0; a < atoms; ++a)
-        if (rng() % 2 || (i == 0 && p.start_from_stock)) s.atoms.set(a);
-      s.raw_stock = i == 0 && p.start_from_stock;  // then every later deposit needs footing
-      if (s.mode == Mode::Additive && rng() % 2) {
-        std::vector<AtomSet> over(std::size_t(atoms), AtomSet{atoms});
-        for (auto& o : over)
-          if (rng() % 3 == 0) o.set(int(rng() % unsigned(atoms)));
-        s.blocked_by = std::make_shared<const AtomRelation>(std::move(over));
-      }
-      if (s.mode == Mode::Additive && rng() % 2) {
-        auto footing = std::make_shared<DepositFooting>();
-        std::vector<AtomSet> carriers;
-        for (int a = 0; a < atoms; ++a) {
-          footing->kind.push_back(rng() % 3 == 0 ? DepositFooting::NeedsCarrier : DepositFooting::OnPlate);
-          carriers.emplace_back(atoms);
-          for (int k = 0, m = 1 + int(rng() % 4); k < m; ++k) carriers.back().set(int(rng() % unsigned(atoms)));
-        }
-        footing->carriers = AtomRelation(std::move(carriers));
-        s.footing = footing;
-      }
-      p.primitives.push_back(std::move(s));
-    }
+    const PlanningProblem p = random_instance(rng, trial);
     const Reachability reach = explore_reachable(p, 1'000'000);
     ASSERT_TRUE(reach.goal || reach.complete) << "trial " << trial;
     const CoreProof proof = prove_by_core(p);
@@ -193,5 +200,48 @@ TEST(CoreProof, AgreesWithTheExhaustiveExplorationOnRandomInstances) {
   EXPECT_GT(feasible, 40);
 }
 
+
+// A proof names the atoms it needs and no others: S as the refinement leaves it also holds
+// atoms that refuted only an earlier projected plan (on the gusset bracket, rows of voxels
+// along the bottom edges, named as if they were the reason), and each of those is dropped
+// again. Without any one atom of a proof, the projection has a plan.
+TEST(CoreProof, EveryAtomOfAProofIsNeededByIt) {
+  std::mt19937 rng(2024);
+  int proven = 0, smaller = 0;
+  for (int trial = 0; trial < 1000; ++trial) {
+    const PlanningProblem p = random_instance(rng, trial);
+    const CoreProof proof = prove_by_core(p);
+    if (proof.outcome != CoreProof::Outcome::Proven) continue;
+    ++proven;
+    smaller += proof.found > int(proof.core.size());
+    EXPECT_TRUE(projection_refutes(p, proof.core, proof.groups)) << "trial " << trial;
+    for (std::size_t k = 0; k < proof.core.size() && proof.core.size() > 1; ++k) {
+      std::vector<int> less = proof.core;
+      less.erase(less.begin() + std::ptrdiff_t(k));
+      EXPECT_FALSE(projection_refutes(p, less, proof.groups)) << "trial " << trial << ", atom " << proof.core[k];
+    }
+  }
+  EXPECT_GT(proven, 40);
+  EXPECT_GT(smaller, 5);  // the refinement's S is often larger than the proof needs
+}
+
+// Air that a raw stock holds and that every removal reaching it cuts design with it: a
+// closed channel. The proof's verdict names it first.
+TEST(CoreProof, AirThatOnlyACutIntoTheDesignClearsIsTold) {
+  enum { Lid, Channel, Outside, Atoms };
+  PlanningProblem p;
+  p.atoms = {{20, true, false}, {30, false, true}, {40, false, true}};
+  p.primitives = {primitive("stock", Mode::Additive, Atoms, {Lid, Channel, Outside}),
+                  primitive("through the lid", Mode::Subtractive, Atoms, {Lid, Channel}),
+                  primitive("around", Mode::Subtractive, Atoms, {Outside}),
+                  primitive("deposit", Mode::Additive, Atoms, {Lid})};
+  p.primitives[0].raw_stock = true;
+  EXPECT_TRUE(cleared_only_by_cutting(p, Channel));
+  EXPECT_FALSE(cleared_only_by_cutting(p, Outside));  // a removal clears it alone
+  EXPECT_FALSE(cleared_only_by_cutting(p, Lid));       // design
+  // Air no stock holds is there only if a deposit lays it: no such thing to clear.
+  p.primitives[0].atoms.set(Channel, false);
+  EXPECT_FALSE(cleared_only_by_cutting(p, Channel));
+}
 }  // namespace
 }  // namespace hybridctl::planner

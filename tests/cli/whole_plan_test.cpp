@@ -1,0 +1,141 @@
+// Parts planned, exported and judged end to end at the machines' own settings, as a user
+// would: the plans offered executed from the raw stock on their own simulated controllers
+// and judged against the STL. Each is a whole run of the pipeline over several plans (a
+// minute in the everyday build, up to a quarter of an hour under the sanitizers), so they
+// carry the ctest label `whole-plan`, which the sanitizer suite leaves out
+// (docs/hardening.md): the code they run is under the sanitizers in the smaller plans of
+// cli_test.cpp, export_test.cpp, run_test.cpp and tests/validation.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "shell.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+using hybridctl::cli_testing::Outcome;
+using hybridctl::cli_testing::slurp;
+
+class WholePlan : public hybridctl::cli_testing::DirectoryTest {
+ protected:
+  WholePlan() : DirectoryTest("whole-plan") {}
+  Outcome run(const std::vector<std::string>& args) { return run_hybridctl(args); }
+};
+
+const std::string kFlangedHub = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/flanged-hub.stl";
+const std::string kMachine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/hybrid-3axis.yaml";
+const std::string kBAxisMachine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/multitask-b-axis.yaml";
+const std::string kParts = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/";
+
+// The slots on the B-axis machine at its own tolerance (0.3 mm, under the 0.5 mm voxel):
+// no cutter fits a slot, so the block is deposited round them. With the tolerance as the
+// voxels' band, the voxels at the top corners beside the slots, which a bead rounds by a
+// voxel, made the part "NOT manufacturable" over 0.125 mm^3 regions; within a band of a
+// voxel they are not a verdict, and the deposit is judged where it matters, on the STL:
+// its faces left as deposited stand out beyond 0.3 mm with the head's accuracy.
+TEST_F(WholePlan, TheSlotsOnTheBAxisMachineAreJudgedOnTheStlNotRefusedOverCornerVoxels) {
+  const Outcome r = run({"plan", kParts + "slots.stl", "--machine", kBAxisMachine, "-o", (dir_ / "plan").string()});
+  EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
+  EXPECT_EQ(r.out.find("verdict     NOT manufacturable"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("region of the design around (15.8, 0.2, 19.8) mm"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("(exact verification, tolerance 0.3 mm, as deposited)"), std::string::npos) << r.out;
+}
+
+// The same tube at the B-axis machine's own tolerance, 0.3 mm, under a voxel: the voxels
+// are judged within a band of a voxel (plan/planning_band.hpp), the part against the STL.
+//
+// Against the STL the roughing's tips on voxel centres used to bite into the tube's round
+// wall between the voxel centres they spare, 0.43 mm deep (exact verification found it,
+// docs/verification.md; the voxels cannot), and every plan was refused. The flat cutters
+// now keep off the STL's real walls and finish them on it (docs/toolpaths.md, "Wall
+// finishing"): the block's plan is offered, and what is left off the surface is the 10 mm
+// bull nose's (action 4: no wall finishing for bull noses yet), within the 0.3 mm. (Its
+// lowest cut used to sit on a voxel centre 0.25 mm above the plate's bottom and leave the
+// block's margin there as a lip; the floor is now cut at its real height.)
+TEST_F(WholePlan, TheTubeOnAPlateAtTheMachinesToleranceIsMilledFromTheBlockWithItsWallsFinished) {
+  const Outcome r = run({"plan", kParts + "tube-plate.stl", "--machine", kBAxisMachine});
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("  1. ((((P2 \u2212 "), std::string::npos) << r.out;  // from the block
+  EXPECT_EQ(r.out.find("exact_gouge: action 2"), std::string::npos) << r.out;  // the rougher's bite is gone
+  EXPECT_NE(r.out.find("exact:     excess 0.249 mm at (25.01, 32.25, 29.25) by action 4 (line "), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("gouge 0.216 mm at (20.21, 18.83, 29.78) by action 4 (line "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("at least"), std::string::npos) << r.out;  // no lip of the margin
+}
+
+// A block with a closed channel whose pointed roof builds without support: every plan
+// offered mills the block up to the channel's floor and deposits only the band above it
+// (docs/bands.md), and each one, exported and run on its own simulated controller from the
+// raw stock, makes the part within tolerance both ways with no alarm.
+// At 0.8 mm: the deposited band's faces stay as deposited, within the powder head's
+// 0.25 mm of the modelled beads, which the machine's 0.5 mm does not allow
+// (docs/verification.md).
+TEST_F(WholePlan, EveryPlanOfTheArchChannelBlockMillsToTheChannelFloorAndRunsWithinTolerance) {
+  const Outcome r = run({"dry-run", std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/arch-channel-block.stl", "--machine",
+                         kMachine, "--tolerance", "0.8", "--all", "-o", (dir_ / "dry").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("dry-run     5 of 5 plans ran to the end with no alarm, within tolerance both ways"), std::string::npos)
+      << r.out;
+  // The band's milling primitive is in every plan: "P19 ... down to z = 22 mm".
+  const std::regex milled("\\n  (P[0-9]+) +SM-max T1 \\(10 mm flat rougher\\) from \\+Z \\(top\\), down to z = 22 mm");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.out, m, milled)) << r.out;
+  const std::string band = m[1];
+  std::size_t plans = 0;
+  const std::regex plan_line("\nplan [0-9]+ +(\\(.*)  cost");
+  for (std::sregex_iterator it(r.out.begin(), r.out.end(), plan_line), end; it != end; ++it, ++plans)
+    EXPECT_NE((*it)[1].str().find(band + ")"), std::string::npos) << (*it)[1];
+  EXPECT_EQ(plans, 5u) << r.out;
+}
+
+// dry-run plans as `plan` does, with its tolerance and reuse: the tolerance asked for is
+// the one planned with and the one the part as built is judged against.
+TEST_F(WholePlan, DryRunPlansAndJudgesWithTheToleranceAskedFor) {
+  const std::string fins = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/fins.stl";
+  const Outcome r = run({"dry-run", fins, "--machine", kMachine, "--tolerance", "0.75", "--reuse", "2", "-o",
+                         (dir_ / "dry").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("), tolerance 0.75 mm\n"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("within tolerance (0.75 mm)"), std::string::npos) << r.out;
+  const std::string json = slurp(dir_ / "dry" / "plan" / "plan.json");
+  EXPECT_NE(json.find("\"max_uses\": 2"), std::string::npos);
+  EXPECT_NE(json.find("\"tolerance\": 0.75"), std::string::npos);
+  EXPECT_EQ(run({"dry-run", fins, "--machine", kMachine, "--tolerance", "-1"}).exit_code, 2);
+  EXPECT_EQ(run({"dry-run", fins, "--machine", kMachine, "--reuse", "0"}).exit_code, 2);
+}
+
+// A repair (issue 16): the worn copy of the flanged hub (2.5 mm gone from half of the
+// flange's top) given as the stock. Every plan starts from it and deposits only what it
+// lacks; one deposits the neighbourhood of the missing region with overfill and mills the
+// top back flat, and every plan offered, run from the worn part on its own simulated
+// controller, makes the hub within tolerance both ways with no alarm.
+TEST_F(WholePlan, AWornHubIsRepairedByDepositingOnlyWhatItLacksAndEveryPlanRunsWithinTolerance) {
+  const std::string source = HYBRIDCTL_SOURCE_DIR;
+  // At 0.7 mm: the repaired faces stay as deposited, within the powder head's 0.25 mm of
+  // the modelled beads, which 0.5 mm does not allow (docs/verification.md).
+  const Outcome r = run({"dry-run", kFlangedHub, "--machine", kMachine, "--voxel", "0.5", "--tolerance", "0.7", "--stock",
+                         source + "/examples/parts/flanged-hub-worn.stl", "--all", "-o", (dir_ / "dry").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("dry-run     5 of 5 plans ran to the end with no alarm, within tolerance both ways"), std::string::npos)
+      << r.out;
+  // "  3. (((P1 ∪ P2) ∪ P17) − P6)": the stock, the deposit near the missing region, a removal.
+  const std::regex local("\\n  (P[0-9]+) +O-AM ded from \\+Z \\(top\\), near the missing 2454 mm");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(r.out, m, local)) << r.out;
+  const std::regex repair("\\n  [0-9]\\. \\(+P1 [^\\n]*∪ " + std::string(m[1]) + "\\) − P[0-9]+\\)  cost");
+  EXPECT_TRUE(std::regex_search(r.out, repair)) << r.out;
+  // Every action after the stock deposits at most the missing 2,454 mm³ and its overfill.
+  const std::regex deposit("\\n     [0-9]\\) P[0-9]+ +[UO]-AM [^\\n]* deposit +([0-9.]+) mm");
+  int deposits = 0;
+  for (auto it = std::sregex_iterator(r.out.begin(), r.out.end(), deposit); it != std::sregex_iterator(); ++it, ++deposits)
+    EXPECT_LT(std::stod((*it)[1]), 2454 * 1.2) << it->str();
+  EXPECT_GE(deposits, 5);
+}
+
+}  // namespace
