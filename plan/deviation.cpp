@@ -66,11 +66,11 @@ std::string direction_text(const char* name, double worst, const std::optional<g
 
 }  // namespace
 
-std::string deviation_text(const Deviation& d, double tolerance) {
+std::string deviation_text(const Deviation& d, double band) {
   return fixed_number(d.over_volume, 1) + " mm\u00B3 over, " + fixed_number(d.under_volume, 1) + " mm\u00B3 under; " +
-         direction_text("out", d.worst_out, d.worst_out_at, tolerance) + ", " +
-         direction_text("missing", d.worst_missing, d.worst_missing_at, tolerance) + ": " +
-         (d.within_tolerance ? "within" : "OUTSIDE") + " tolerance (" + shortest_number(tolerance) + " mm)";
+         direction_text("out", d.worst_out, d.worst_out_at, band) + ", " +
+         direction_text("missing", d.worst_missing, d.worst_missing_at, band) + ": " +
+         (d.within_tolerance ? "within" : "OUTSIDE") + " the planning band (" + shortest_number(band) + " mm)";
 }
 
 namespace {

@@ -76,8 +76,9 @@ Deviation measure_deviation(const geometry::Solid& made, const geometry::Solid& 
                             const geometry::IndexBox& domain, double tolerance);
 
 // One line for people, as `plan` and `dry-run` print it: volumes over and under, both
-// directions (with where, when beyond the tolerance), and "within tolerance" only when
-// both hold.
-std::string deviation_text(const Deviation& d, double tolerance);
+// directions (with where, when beyond `band`), and "within the planning band" only when
+// both hold. The voxels are judged within the planning band (plan/planning_band.hpp), never
+// the drawing's tolerance: that is exact_deviation_text's to say.
+std::string deviation_text(const Deviation& d, double band);
 
 }  // namespace hybridctl::plan

@@ -415,6 +415,12 @@ TEST_F(Run, DryRunComparesAsBuiltWithAsPlanned) {
   EXPECT_LE(extra, 0.10 * planned);
   EXPECT_LE(missing, 0.02 * planned);
   EXPECT_TRUE(slurp(dir_ / "out" / "plan-1" / "executed-lines.ngc") == slurp(dir_ / "out" / "plan-1" / "job" / "program.ngc"));
+  // The voxels are judged within their band; the program the controller ran, against the
+  // STL, within the tolerance.
+  EXPECT_NE(out.find("\non voxels   "), std::string::npos) << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex("\nvs STL      excess [0-9.]+ mm.*; [0-9.]+ % of the surface within 0.5 mm: "
+                                                "within tolerance\n")))
+      << out;
 }
 
 }  // namespace

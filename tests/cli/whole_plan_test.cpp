@@ -102,7 +102,8 @@ TEST_F(WholePlan, DryRunPlansAndJudgesWithTheToleranceAskedFor) {
                          (dir_ / "dry").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("), tolerance 0.75 mm\n"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("within tolerance (0.75 mm)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("within the planning band (0.75 mm)"), std::string::npos) << r.out;  // the voxels
+  EXPECT_NE(r.out.find("% of the surface within 0.75 mm: within tolerance\nwrote"), std::string::npos) << r.out;  // the STL
   const std::string json = slurp(dir_ / "dry" / "plan" / "plan.json");
   EXPECT_NE(json.find("\"max_uses\": 2"), std::string::npos);
   EXPECT_NE(json.find("\"tolerance\": 0.75"), std::string::npos);

@@ -1,5 +1,5 @@
 // plan::measure_deviation: the one measure of how far a made solid is from the design,
-// both ways (plan.json's deviation, dry-run's "vs design" line). Known distances on
+// both ways (plan.json's deviation, dry-run's "on voxels" line). Known distances on
 // simple voxel shapes, and the half-voxel convention.
 
 #include "plan/deviation.hpp"
@@ -137,11 +137,11 @@ TEST(Deviation, TextSaysWithinOnlyWhenBothDirectionsHold) {
   const Solid plate = box({2, 2, 2}, {20, 20, 5});
   const Solid design = unite(plate, box({10, 4, 5}, {11, 18, 15}));
   const std::string missing_fin = deviation_text(measure_deviation(plate, design, kDomain, 1.0), 1.0);
-  EXPECT_NE(missing_fin.find("OUTSIDE tolerance"), std::string::npos) << missing_fin;
+  EXPECT_NE(missing_fin.find("OUTSIDE the planning band (1 mm)"), std::string::npos) << missing_fin;
   EXPECT_NE(missing_fin.find("missing 10.00 mm at (10.50, "), std::string::npos) << missing_fin;
   EXPECT_EQ(missing_fin.find("within"), std::string::npos) << missing_fin;
   const std::string exact = deviation_text(measure_deviation(design, design, kDomain, 1.0), 1.0);
-  EXPECT_NE(exact.find("within tolerance"), std::string::npos) << exact;
+  EXPECT_NE(exact.find("within the planning band (1 mm)"), std::string::npos) << exact;
 }
 
 }  // namespace
