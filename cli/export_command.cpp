@@ -44,6 +44,7 @@ int export_plan_programs(const plan::PlanFile& file, const ExportRequest& reques
       throw InputError("--dialect " + request.dialect + ": expected rs274ngc or fanuc");
     }
   }
+  if (request.arcs == "lines") options.arcs.output = toolpaths::ArcOutput::Lines;
   const std::string name = "plan-" + std::to_string(request.rank);
   options.post.program_name = name + " " + plan.expression;
   ProgressBar bar("toolpaths");
@@ -106,6 +107,11 @@ void add_export_command(CLI::App& app, Runner& runner) {
                   "the plan's, unless --machine-override");
   cmd->add_flag("--machine-override", request->machine_override,
                 "With --machine: use it even when it is not the machine the plan was made with");
+  cmd->add_option("--arcs", request->arcs,
+                  "fit: feed moves that follow a circle within 0.001 mm become G2/G3 arcs; lines: G1 moves only, as "
+                  "the toolpaths make them")
+      ->default_val("fit")
+      ->check(CLI::IsMember({"fit", "lines"}));
   cmd->callback([&runner, request] { runner = [request] { return export_plan_programs(*request); }; });
 }
 

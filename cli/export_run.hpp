@@ -14,6 +14,7 @@ struct ExportRequest {
   std::string dialect;  // empty: the machine file's
   std::string machine;  // empty: the machine plan.json embeds (plan/plan_machine.hpp)
   bool machine_override = false;  // take `machine` even when it is another machine
+  std::string arcs = "fit";       // "fit": circular runs of feed moves as G2/G3; "lines": G1 only
 };
 
 int export_plan_programs(const ExportRequest& request);

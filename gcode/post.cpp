@@ -228,6 +228,9 @@ class Writer {
   void comment(std::string_view s) { line("(" + comment_text(s) + ")"); }
   void number(std::string& out, double v) { append_number(out, v, fanuc_); }
 
+  /// A coordinate as the program writes it (append_number's rounding to 0.0001 mm).
+  static double written(double v) { return std::round(v * 10000.0) / 10000.0; }
+
   void forget_position() { known_[0] = known_[1] = known_[2] = false; }
 
   void retract_to_top() {
@@ -391,10 +394,13 @@ class Writer {
       any_axis = true;
     }
     if (arc) {
+      // Offsets from the start as written (4 decimals), where the controller is: the centre
+      // it computes is then ours to within 0.00005 mm per axis, and its start and end
+      // radii agree to about 0.0002 mm (LinuxCNC refuses a difference beyond its tolerance).
       buffer_ += " I";
-      number(buffer_, centre.x - position_.x);
+      number(buffer_, centre.x - written(position_.x));
       buffer_ += " J";
-      number(buffer_, centre.y - position_.y);
+      number(buffer_, centre.y - written(position_.y));
     }
     if (xy_only) {
       position_.x = to.x;

@@ -337,7 +337,8 @@ void MaterialSimulation::set_protected_region(std::optional<geometry::Solid> pro
 }
 
 double MaterialSimulation::chord_tolerance() const {
-  return options_.arc_tolerance > 0 ? options_.arc_tolerance : stock_.voxel_size() / 10;
+  return options_.arc_tolerance > 0 ? options_.arc_tolerance
+                                    : std::min(stock_.voxel_size() / 10, SimulationOptions::kDefaultArcTolerance);
 }
 
 MoveReport MaterialSimulation::cut(const Cutter& cutter, const MaterialMove& move) {

@@ -23,9 +23,13 @@
 namespace hybridctl::sim {
 
 struct SimulationOptions {
-  // Largest distance (mm) between an arc and the chords it is simulated with; 0 means a
-  // tenth of the voxel size.
+  // Largest distance (mm) between an arc and the chords it is simulated with; 0 means the
+  // finer of a tenth of the voxel size and kDefaultArcTolerance.
   double arc_tolerance = 0;
+  // The toolpaths' own chord tolerance (toolpaths/arc_fit.hpp, wall finishing's round
+  // joins): an arc fitted to a finishing pass is simulated as closely as the G1 chords it
+  // replaces, so fitting arcs changes no voxel the pass takes.
+  static constexpr double kDefaultArcTolerance = 0.001;
 };
 
 enum class IncidentKind {

@@ -109,9 +109,16 @@ void make_program(const plan::PlanFile& file, const geometry::IndexBox& simulate
     if (design) {
       pocket.design = design->in(setup.approach);
       pocket.design_voxels = &file.design;
+      // A third of the tolerance for the scallops: room for a slope's wider ones and for
+      // what the finishing's thinning and the controller's rounding add.
+      if (file.tolerance > 0) pocket.scallop = file.tolerance / 3;
+      pocket.finish_region = &p.region;
     }
     prog.path = pocket_path(a.roi, a.after, a.before, *tool, setup, pocket);
   }
+  // Milling paths and deposition contours whose feed moves follow circles, as arcs
+  // (rasters and lattice steps are straight and stay as they are).
+  if (options.arcs.output == ArcOutput::Fit) prog.path = fit_arcs(std::move(prog.path), options.arcs);
   // A path with no move makes no G-code: its block would only approach the path's
   // (meaningless) start. Why stays in the note, its defects in the program.
   a.makes_gcode = !prog.path.moves.empty();

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "config/machine.hpp"
+#include "toolpaths/arc_fit.hpp"
 #include "toolpaths/deposition_path.hpp"
 #include "toolpaths/pocket_path.hpp"
 #include "gcode/post.hpp"
@@ -29,6 +30,10 @@ namespace hybridctl::toolpaths {
 struct ExportOptions {
   DepositionOptions deposition;
   PocketOptions pocket;
+  // Circular runs of feed moves (wall finishing's round joins and offsets, deposition
+  // contours) as G2/G3 arcs within arcs.chord_tolerance (0.001 mm: within the finishing's
+  // own accuracy); `arcs.output = ArcOutput::Lines` keeps the generators' G1 chords.
+  ArcFitOptions arcs;
   gcode::PostOptions post;
   // Progress: the action being made (1-based) of how many.
   std::function<void(int action, int actions)> progress;

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <string>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "geometry/solid.hpp"
+#include "toolpaths/drop_cutter.hpp"
 #include "toolpaths/pocket_cells.hpp"
 #include "toolpaths/pocket_path.hpp"
 #include "toolpaths/pocket_tool.hpp"
@@ -47,9 +49,10 @@ class PocketBuilder {
       : tool_(tool), options_(options), path_(path) {}
 
   // `design`: the design's voxels in the work frame, or null (then made from
-  // PocketOptions::design when finishing).
+  // PocketOptions::design when finishing); `finish_region`: PocketOptions::finish_region in
+  // the work frame, or null for the ROI.
   Toolpath& run(const geometry::Solid& roi, const geometry::Solid& keep, const geometry::Solid& stock,
-                const geometry::Solid* design = nullptr);
+                const geometry::Solid* design = nullptr, const geometry::Solid* finish_region = nullptr);
 
  private:
   using Solid = geometry::Solid;
@@ -141,14 +144,33 @@ class PocketBuilder {
   std::optional<std::vector<Point2>> finish_pass(const FinishLevel& f, const FinishRun& run, Point2 from) const;
   void cut_finish_pass(const FinishLevel& f, const std::vector<Point2>& pts);
   // contact_height at any point (mm, work frame), not only at a cell's centre: exact for
-  // the voxels' column tops.
-  double contact_height_at(Point2 p, Part part) const;
+  // the voxels' column tops (`tops`: tops_, or another set's over tops_box_).
+  double contact_height_at(Point2 p, Part part) const { return contact_height_at(p, part, tops_); }
+  double contact_height_at(Point2 p, Part part, const std::vector<int>& tops) const;
   double rapid_stop_at(Point2 p, double at_least) const;
   Cell cell_of(Point2 p) const {
     return {int(std::floor((p.x - lattice_.origin.x) / h_)), int(std::floor((p.y - lattice_.origin.y) / h_))};
   }
   // Removes from the material still there what the cutter takes along the polyline at `z`.
   void stamp_polyline(const std::vector<Point2>& points, double z);
+
+  // Surface finishing (pocket_surface.cpp): ball and bull noses on the design's STL.
+  // `region`: what the action may remove; the faces next to it are finished.
+  void start_surface_finishing(const Solid& region, const Solid* design);
+  void finish_surfaces();
+  // The lowest tip height at p clear of the design's surface, of what must stay that is
+  // not design, and with the body clear of all material; -infinity when nothing is there.
+  double surface_tip_at(Point2 p) const;
+  // The path along the straight line a-b at surface_tip_at's heights: samples, refined
+  // where the chord between two would dip under the surface, thinned where it would not.
+  std::vector<Vec3> surface_line(Point2 a, Point2 b) const;
+  bool in_surface_domain(Point2 p) const;
+  // The tip cells where roughing at height z would come closer to the STL than it leaves
+  // for the finishing passes (none when the run does not finish surfaces).
+  SliceMask under_surface(double z) const;
+  void cut_surface_pass(const std::vector<Vec3>& pts, bool linked);
+  // Removes from the material still there what the cutter takes along `pts`.
+  void stamp_surface_pass(const std::vector<Vec3>& pts);
 
   config::CuttingTool tool_;
   PocketOptions options_;
@@ -180,6 +202,14 @@ class PocketBuilder {
   double rough_margin_ = 0;  // mm the roughing's tips keep beyond the keep-out region
   Solid roi_, design_;       // work frame
   std::vector<double> face_heights_;  // of the design's faces square to the axis, top-down
+  // Surface finishing.
+  std::shared_ptr<const DropCutter> drop_;
+  std::vector<int> obstacle_tops_;  // over tops_box_: what must stay that is not design
+  SliceMask surface_domain_;        // tip cells whose passes finish this region's faces
+  double surface_step_over_ = 0;    // mm between rows
+  double surface_floor_ = 0;        // mm: the region's bottom, below which no pass goes
+  std::vector<double> rough_tips_;  // over work_'s cells: the lowest roughing tip height
+  int surface_passes_ = 0;
   int finish_passes_ = 0, finish_skipped_ = 0;
   double finish_length_ = 0, finish_skipped_length_ = 0;  // mm
 };

@@ -145,7 +145,7 @@ SliceMask PocketBuilder::cells_in(const TipKeepOut& region) const {
   return out;
 }
 
-double PocketBuilder::contact_height_at(Point2 p, Part part) const {
+double PocketBuilder::contact_height_at(Point2 p, Part part, const std::vector<int>& tops) const {
   const std::vector<double>& run = part == Part::Whole    ? model_.run_whole
                                    : part == Part::Cutter ? model_.run_cutter
                                                           : model_.run_body;
@@ -156,7 +156,8 @@ double PocketBuilder::contact_height_at(Point2 p, Part part) const {
   double need = -kInf;
   for (int y = lo.y; y <= hi.y; ++y)
     for (int x = lo.x; x <= hi.x; ++x) {
-      const int top = top_at(x, y);
+      const int top = tops[std::size_t(y - tops_box_.lo.y) * std::size_t(tops_box_.hi.x - tops_box_.lo.x) +
+                           std::size_t(x - tops_box_.lo.x)];
       if (top == kNoVoxel) continue;
       const double dx = lattice_.origin.x + (x + 0.5) * h_ - p.x, dy = lattice_.origin.y + (y + 0.5) * h_ - p.y;
       const double zmin = first_reach(run, model_.profile_step, dx * dx + dy * dy);

@@ -393,7 +393,8 @@ void PocketBuilder::report_what_stays() {
   }
 }
 
-Toolpath& PocketBuilder::run(const Solid& roi, const Solid& keep, const Solid& stock, const Solid* design) {
+Toolpath& PocketBuilder::run(const Solid& roi, const Solid& keep, const Solid& stock, const Solid* design,
+                             const Solid* finish_region) {
   lattice_ = roi.lattice();
   h_ = lattice_.voxel_size;
   model_ = make_tool(tool_, h_);
@@ -408,12 +409,14 @@ Toolpath& PocketBuilder::run(const Solid& roi, const Solid& keep, const Solid& s
   const Levels levels = cutting_levels();
   level_heights_ = exact_heights(levels);
   start_finishing(roi, design);
+  start_surface_finishing(finish_region ? *finish_region : roi, design);
   int level_number = 0;
   int k_above = rb.hi.z;  // the ROI's layers [k, k_above) are level k's to remove
   double z_above = lattice_.origin.z + rb.hi.z * h_;
   for (const int k : levels) {
     if (remaining_.empty()) break;
     SliceMask usable = usable_tips(allowed, k);
+    if (drop_) usable = usable.without(under_surface(level_z(k)));
     std::optional<TipKeepOut> keep_out;
     if (finishing_) {
       // The roughing keeps the cutter off the design's real surface, not only off the
@@ -432,6 +435,7 @@ Toolpath& PocketBuilder::run(const Solid& roi, const Solid& keep, const Solid& s
     k_above = k;
     z_above = level_z(k);
   }
+  finish_surfaces();
   if (started_ && at_.z < safe_z_) move(MoveKind::Rapid, {at_.x, at_.y, safe_z_}, 0, false);
   report_what_stays();
   return path_;
@@ -460,14 +464,20 @@ Toolpath pocket_path(const geometry::Solid& roi_part, const geometry::Solid& kee
   const Solid keep = keep_part.empty() ? Solid(roi.lattice(), {}) : part_to_work(keep_part, setup.approach);
   const Solid stock = stock_part.empty() ? Solid(roi.lattice(), {}) : part_to_work(stock_part, setup.approach);
   std::optional<Solid> design;
-  if (options.design_voxels && options.design && !options.design->empty() && options.finish_walls &&
-      tool.type == config::ToolType::Flat) {
+  const bool exact = tool.type == config::ToolType::Flat ? options.finish_walls : options.finish_surfaces;
+  if (options.design_voxels && options.design && !options.design->empty() && exact) {
     if (!(options.design_voxels->lattice() == roi_part.lattice()))
       throw std::invalid_argument("pocket_path: the design's voxels are on another lattice than the ROI");
     design = part_to_work(*options.design_voxels, setup.approach);
   }
+  std::optional<Solid> finish_region;
+  if (design && options.finish_region) {
+    if (!(options.finish_region->lattice() == roi_part.lattice()))
+      throw std::invalid_argument("pocket_path: the finishing region is on another lattice than the ROI");
+    finish_region = part_to_work(*options.finish_region, setup.approach);
+  }
   pocket::PocketBuilder builder(tool, options, path);
-  builder.run(roi, keep, stock, design ? &*design : nullptr);
+  builder.run(roi, keep, stock, design ? &*design : nullptr, finish_region ? &*finish_region : nullptr);
   return path;
 }
 

@@ -17,7 +17,8 @@
 // Entries plunge only where the tool meets no material on the way down; elsewhere they
 // lead in sideways from air, or ramp along the first segment at ramp_angle_deg.
 // Given the design's STL (PocketOptions::design), a flat cutter then follows the design's
-// real walls at each level (wall finishing), off the lattice.
+// real walls at each level (wall finishing), off the lattice; a ball or bull nose finishes
+// the faces under the region by a drop-cutter raster on the STL (surface finishing).
 
 #include <memory>
 #include <optional>
@@ -80,6 +81,17 @@ struct PocketOptions {
   const geometry::Solid* design_voxels = nullptr;
   // Wall finishing on (default) or off (the roughing alone, for comparison).
   bool finish_walls = true;
+  // Surface finishing with ball and bull-nose cutters, given `design` (docs/toolpaths.md,
+  // "Surface finishing"): after the levels, a drop-cutter raster on the design's real
+  // surface wherever the region lies on it, its rows close enough that the scallops on a
+  // flat face stand at most `scallop` mm (the tool's step_over caps the step). Off: the
+  // Z-levels alone, as they leave a curved face (a staircase of step-downs).
+  bool finish_surfaces = true;
+  double scallop = 0.1;
+  // The region the action may remove (part frame, on the solids' lattice: its primitive's),
+  // or null for the ROI: the faces it finishes are the design's faces next to it, also
+  // where an earlier action left less than a voxel on them (within the ROI's reach).
+  const geometry::Solid* finish_region = nullptr;
   // Overrides of the tool's step_down and step_over (mm).
   std::optional<double> step_down;
   std::optional<double> step_over;

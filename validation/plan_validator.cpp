@@ -1,6 +1,7 @@
 #include "validation/plan_validator.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <utility>
 #include <optional>
@@ -15,6 +16,42 @@ namespace {
 
 // Candidates beyond the tolerance against the STL before the rest are not verified.
 constexpr int kExactFailuresBeforeGivingUp = 3;
+
+// Where a candidate left the part beyond the tolerance against the STL: its actions up to
+// the one that left that surface (their primitives), and the place.
+struct ExactFailure {
+  std::vector<int> prefix;
+  bool excess = true;  // material out of the surface (else a gouge)
+  geometry::Vec3 at;
+  double mm = 0;
+};
+
+// Whether `region` holds a voxel next to the one at `at` (26-neighbourhood, itself included).
+bool reaches(const geometry::Solid& region, geometry::Vec3 at) {
+  const geometry::Lattice& l = region.lattice();
+  const geometry::Index3 c{int(std::floor((at.x - l.origin.x) / l.voxel_size)), int(std::floor((at.y - l.origin.y) / l.voxel_size)),
+                           int(std::floor((at.z - l.origin.z) / l.voxel_size))};
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        if (region.contains({c.x + dx, c.y + dy, c.z + dz})) return true;
+  return false;
+}
+
+// The candidate leaves the same surface as `f` did: it begins with f's actions (execution
+// is deterministic: the same material there after them), and nothing after them could
+// change that place (no removal reaches an excess, no deposit a gouge).
+bool repeats(const ExactFailure& f, const plan::PlanFile& file, const plan::PlanFilePlan& candidate) {
+  const auto& actions = candidate.actions;
+  if (actions.size() < f.prefix.size() ||
+      !std::equal(f.prefix.begin(), f.prefix.end(), actions.begin(),
+                  [](int p, const plan::PlanFileAction& a) { return p == a.primitive; }))
+    return false;
+  return std::none_of(actions.begin() + std::ptrdiff_t(f.prefix.size()), actions.end(), [&](const plan::PlanFileAction& a) {
+    const plan::PlanFilePrimitive& p = file.primitives.at(std::size_t(a.primitive));
+    return (p.mode == config::Mode::Subtractive) == f.excess && reaches(p.region, f.at);
+  });
+}
 
 // Minutes per action of an execution that ran to its end: each action's own program under
 // the time model of `gcode check`.
@@ -51,8 +88,10 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
     std::shared_ptr<PrefixCache> cache;
     // Exact verification: candidates that made the part on the voxels but not against the
     // STL, and whether any made it against the STL. Its failures come from how faces are
-    // cut and laid, which the search's next candidates mostly share; past a few, the rest
-    // are turned down unexecuted rather than verified one by one.
+    // cut and laid: a candidate that runs the action which left a face out and nothing
+    // after it that reaches that place leaves it the same, and is turned down unexecuted;
+    // past a few failures, every other one is too.
+    std::vector<ExactFailure> exact_failed;
     int exact_failures = 0;
     bool exact_passed = false;
     double closest_mm = 0;
@@ -76,6 +115,18 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
         known.reasons = failed.reasons;
         return known;
       }
+    for (const ExactFailure& f : state->exact_failed)
+      if (repeats(f, file, candidate)) {
+        plan::CandidateRun known;
+        known.reasons = {{f.excess ? "exact_excess" : "exact_gouge", 0, 0,
+                          "not executed: its first " + std::to_string(f.prefix.size()) +
+                              " actions left the part " + fixed_number(f.mm, 3) + " mm " +
+                              (f.excess ? "out of" : "inside") + " the design's surface at (" + fixed_number(f.at.x, 2) +
+                              ", " + fixed_number(f.at.y, 2) + ", " + fixed_number(f.at.z, 2) +
+                              ") mm in a candidate executed before, and nothing after them reaches that place",
+                          f.at}};
+        return known;
+      }
     if (!state->exact_passed && state->exact_failures >= kExactFailuresBeforeGivingUp) {
       plan::CandidateRun skipped;
       skipped.reasons = {{"not_verified", 0, 0,
@@ -97,6 +148,13 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
           const double off = std::max(run.exact->excess.mm, run.exact->gouge.mm);
           state->closest_mm = state->exact_failures == 0 ? off : std::min(state->closest_mm, off);
           ++state->exact_failures;
+          const bool excess = run.exact->excess.mm >= run.exact->gouge.mm;
+          const plan::ExactPlace& place = excess ? run.exact->excess : run.exact->gouge;
+          if (place.at && place.action >= 1 && std::size_t(place.action) <= candidate.actions.size()) {
+            ExactFailure f{{}, excess, *place.at, place.mm};
+            for (int k = 0; k < place.action; ++k) f.prefix.push_back(candidate.actions[std::size_t(k)].primitive);
+            state->exact_failed.push_back(std::move(f));
+          }
         }
       }
       if (run.stopped_after > 0) {

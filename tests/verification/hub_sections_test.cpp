@@ -736,12 +736,14 @@ TEST_F(HubSections, EachSectionsLargestExcessAndGougeAreTheOnesTheProductReports
     EXPECT_NEAR(product_excess, sampled_excess, kAgree);
     EXPECT_NEAR(product_gouge, sampled_gouge, kAgree);
     // The flat rougher's side follows the STL's wall at 0.0002 to 0.0012 mm (clearance and
-    // chord tolerance) plus the G-code's 0.0001 mm rounding: by LinuxCNC's reading and these
-    // sections, the part stands off by no more than that and is nowhere inside. (Milled on
-    // the voxels alone, the walls followed their staircases, 0.25-0.35 mm out and up to
-    // 0.12 mm in.)
+    // chord tolerance) plus the G-code's 0.0001 mm rounding, and where export fitted an arc
+    // to the pass up to 0.001 mm more (the arc fitter's chord tolerance: an arc stands out
+    // of the chords it replaces by up to that, away from its centre, and never passes inside
+    // them: docs/toolpaths.md, "Arc fitting"): by LinuxCNC's reading and these sections,
+    // the part stands off by no more than that and is nowhere inside. (Milled on the voxels
+    // alone, the walls followed their staircases, 0.25-0.35 mm out and up to 0.12 mm in.)
     EXPECT_GT(section_excess, 0.0001);
-    EXPECT_LT(section_excess, 0.0013);
+    EXPECT_LT(section_excess, 0.0013 + 0.001);
     EXPECT_LT(section_gouge, 1e-6);
     EXPECT_NEAR(product_excess, section_excess, kAgree / 10);
   }

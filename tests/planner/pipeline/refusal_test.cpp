@@ -85,8 +85,10 @@ TEST(Refusal, TheGussetBracketIsRefusedForAGussetCornerNoCutterClears) {
   const geometry::Box3 part = r.design.bounding_box_mm();
   for (std::size_t i = 0; i < r.verdict.violations.size() && i < 10; ++i) {
     const AtomSpec& spec = r.problem.atoms[std::size_t(r.verdict.violations[i].atom)];
-    if (spec.must_in || spec.must_out)  // the band's atoms come last; `plan` does not list them
+    // The band's atoms come last; `plan` does not list them.
+    if (spec.must_in || spec.must_out) {
       EXPECT_FALSE(along_a_bottom_edge(r.verdict.violations[i], part)) << r.verdict.violations[i].description;
+    }
   }
 }
 

@@ -1,0 +1,278 @@
+// Surface finishing (docs/toolpaths.md, "Surface finishing"): after the Z-levels, a ball or
+// bull-nose cutter runs a zigzag raster over the faces its region lies on, the tip at the
+// height where the cutter touches the design's STL (toolpaths/drop_cutter.hpp), so that a
+// slope, a fillet or a dome is cut on the real surface rather than left as the levels'
+// staircase.
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "geometry/voxelize.hpp"
+#include "toolpaths/pocket_builder.hpp"
+
+namespace hybridctl::toolpaths::pocket {
+
+namespace {
+
+// The chord between two path points may pass at most this far (mm) under the surface
+// between them before the pair is refined, and a point is dropped when it lies at most
+// kThinning under the chord of its neighbours (the path then stands that much higher).
+constexpr double kChordGouge = 0.0005;
+constexpr double kThinning = 0.002;
+constexpr int kMaxRefinement = 10;
+// What the roughing leaves on the design's faces for the finishing passes (mm), beyond
+// what the lattice makes it leave.
+constexpr double kRoughLeave = 0.01;
+
+bool finite(const geometry::Vec3& p) { return std::isfinite(p.z); }
+
+}  // namespace
+
+void PocketBuilder::start_surface_finishing(const Solid& region, const Solid* design) {
+  drop_.reset();
+  if (!options_.finish_surfaces || !options_.design || options_.design->empty() || tool_.type == config::ToolType::Flat)
+    return;
+  if (!(options_.scallop > 0)) throw std::invalid_argument("pocket_path: the scallop height must be > 0 mm");
+  if (design_.empty())
+    design_ = design ? *design
+                     : geometry::voxelize(geometry::TriangleMesh{*options_.design}, lattice_, "design",
+                                          geometry::VoxelizeMethod::ExactScan);
+  const CutterShape shape = cutter_shape(tool_);
+  surface_step_over_ = std::min(step_over_, scallop_step_over(shape, options_.scallop));
+  // What must stay is an obstacle on the voxels, except the design's own voxels: the
+  // design is the STL, and its voxels reach up to half a voxel past it.
+  obstacle_tops_ = column_top_indices(geometry::subtract(untouchable_, design_), tops_box_);
+  // The faces this region lies on: columns where a voxel of the region touches a design
+  // voxel (a face's neighbour, below included), and the tip positions whose cutter reaches
+  // them; within the tip domain (the ROI's, where the material is known).
+  surface_domain_ = SliceMask(work_.lo.x, work_.lo.y, work_.hi.x - work_.lo.x, work_.hi.y - work_.lo.y);
+  IndexBox rb = region.bounding_box();
+  rb.lo.x = std::max(rb.lo.x, work_.lo.x), rb.lo.y = std::max(rb.lo.y, work_.lo.y);
+  rb.hi.x = std::min(rb.hi.x, work_.hi.x), rb.hi.y = std::min(rb.hi.y, work_.hi.y);
+  int lowest = rb.hi.z;  // the lowest of those voxels: no pass goes below its bottom
+  bool any = false;
+  for (int z = rb.lo.z; z < rb.hi.z; ++z)
+    for (int y = rb.lo.y; y < rb.hi.y; ++y)
+      for (int x = rb.lo.x; x < rb.hi.x; ++x) {
+        if (surface_domain_.at(x, y) || !region.contains({x, y, z})) continue;
+        if (design_.contains({x - 1, y, z}) || design_.contains({x + 1, y, z}) || design_.contains({x, y - 1, z}) ||
+            design_.contains({x, y + 1, z}) || design_.contains({x, y, z - 1})) {
+          surface_domain_.set(x, y);
+          lowest = std::min(lowest, z);
+          any = true;
+        }
+      }
+  if (!any) return;
+  surface_floor_ = lattice_.origin.z + lowest * h_;
+  surface_domain_ = grow_by_disc(surface_domain_, shape.radius / h_ + 1);
+  drop_ = std::make_shared<const DropCutter>(options_.design, shape);
+  // The roughing's tips at the cell centres, kept off the STL by kRoughLeave. Between two
+  // neighbouring centres the cutter stays off it too where the surface is flat or concave
+  // (the drop height is then linear or convex along the step); over a convex one it may
+  // dip by the step's sagitta on the surface's curvature plus the cutter's, a few
+  // thousandths, which the leave covers. A wider cutter would keep the levels a voxel off
+  // every steep wall, which the raster does not finish.
+  const DropCutter& rough = *drop_;
+  rough_tips_.assign(std::size_t(work_.hi.x - work_.lo.x) * std::size_t(work_.hi.y - work_.lo.y), -kInf);
+  for (int y = work_.lo.y; y < work_.hi.y; ++y)
+    for (int x = work_.lo.x; x < work_.hi.x; ++x)
+      rough_tips_[std::size_t(y - work_.lo.y) * std::size_t(work_.hi.x - work_.lo.x) + std::size_t(x - work_.lo.x)] =
+          rough.tip_height({lattice_.origin.x + (x + 0.5) * h_, lattice_.origin.y + (y + 0.5) * h_}) + kRoughLeave;
+}
+
+SliceMask PocketBuilder::under_surface(double z) const {
+  SliceMask out(work_.lo.x, work_.lo.y, work_.hi.x - work_.lo.x, work_.hi.y - work_.lo.y);
+  if (!drop_) return out;
+  for (int y = work_.lo.y; y < work_.hi.y; ++y)
+    for (int x = work_.lo.x; x < work_.hi.x; ++x)
+      if (rough_tips_[std::size_t(y - work_.lo.y) * std::size_t(work_.hi.x - work_.lo.x) + std::size_t(x - work_.lo.x)] >
+          z + kHeightSlack)
+        out.set(x, y);
+  return out;
+}
+
+bool PocketBuilder::in_surface_domain(Point2 p) const { return surface_domain_.at(cell_of(p)); }
+
+double PocketBuilder::surface_tip_at(Point2 p) const {
+  const double under = std::max(drop_->tip_height(p), contact_height_at(p, Part::Cutter, obstacle_tops_));
+  // Over air, or hanging past an edge further down than the region goes: nothing of this
+  // region to finish there, and no call to go down beside the part.
+  if (under < surface_floor_ - 1e-9) return -kInf;
+  return std::max(under, contact_height_at(p, Part::Body));
+}
+
+std::vector<geometry::Vec3> PocketBuilder::surface_line(Point2 a, Point2 b) const {
+  auto at = [&](double t) {
+    const Point2 q{a.x + t * (b.x - a.x), a.y + t * (b.y - a.y)};
+    return Vec3{q.x, q.y, surface_tip_at(q)};
+  };
+  const double length = std::hypot(b.x - a.x, b.y - a.y);
+  const double sample = std::min({0.25, h_ / 2, surface_step_over_});
+  const int n = std::max(1, int(std::ceil(length / sample)));
+  std::vector<Vec3> dense{at(0)};
+  // Where the chord between two samples passes under the surface at their middle, the
+  // middle joins the path, and so on down to kMaxRefinement halvings.
+  auto refine = [&](auto&& self, double t0, const Vec3& p0, double t1, const Vec3& p1, int depth) -> void {
+    if (depth >= kMaxRefinement || !finite(p0) || !finite(p1)) return;
+    const double tm = (t0 + t1) / 2;
+    const Vec3 m = at(tm);
+    if (finite(m) && m.z <= (p0.z + p1.z) / 2 + kChordGouge) return;
+    self(self, t0, p0, tm, m, depth + 1);
+    dense.push_back(m);
+    self(self, tm, m, t1, p1, depth + 1);
+  };
+  for (int i = 1; i <= n; ++i) {
+    const double t0 = double(i - 1) / n, t1 = double(i) / n;
+    const Vec3 p0 = dense.back(), p1 = at(t1);
+    refine(refine, t0, p0, t1, p1, 0);
+    dense.push_back(p1);
+  }
+  // Thinning: a point goes when every point between its kept neighbours lies under their
+  // chord by at most kThinning, and none above it.
+  std::vector<Vec3> out;
+  std::size_t i = 0;
+  while (i < dense.size()) {
+    out.push_back(dense[i]);
+    if (!finite(dense[i])) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i + 1;
+    while (j + 1 < dense.size() && finite(dense[j + 1]) && j + 1 - i <= 400) {
+      const Vec3 &p = dense[i], &q = dense[j + 1];
+      const double lx = q.x - p.x, ly = q.y - p.y, l2 = lx * lx + ly * ly;
+      bool ok = l2 > 0;
+      for (std::size_t k = i + 1; k <= j && ok; ++k) {
+        const double t = ((dense[k].x - p.x) * lx + (dense[k].y - p.y) * ly) / l2;
+        const double chord = p.z + t * (q.z - p.z);
+        ok = dense[k].z <= chord + 1e-9 && dense[k].z >= chord - kThinning;
+      }
+      if (!ok) break;
+      ++j;
+    }
+    i = j;
+  }
+  return out;
+}
+
+void PocketBuilder::stamp_surface_pass(const std::vector<Vec3>& pts) {
+  if (pts.empty()) return;
+  const CutterShape& shape = drop_->shape();
+  const double R = shape.radius;
+  double x0 = pts[0].x, x1 = x0, y0 = pts[0].y, y1 = y0;
+  for (const Vec3& p : pts) x0 = std::min(x0, p.x), x1 = std::max(x1, p.x), y0 = std::min(y0, p.y), y1 = std::max(y1, p.y);
+  const Cell lo = cell_of({x0 - R, y0 - R}), hi = cell_of({x1 + R, y1 + R});
+  const int nx = hi.x - lo.x + 1, ny = hi.y - lo.y + 1;
+  // Per column, the lowest point of the cutter over it along the pass, and the lowest top
+  // of its flutes there: what lies between is gone (an under-estimate of what is removed,
+  // so the material left may only be over-estimated).
+  std::vector<double> bottom(std::size_t(nx) * std::size_t(ny), kInf), top(bottom.size(), kInf);
+  auto visit = [&](const Vec3& q) {
+    const Cell a = cell_of({q.x - R, q.y - R}), b = cell_of({q.x + R, q.y + R});
+    for (int y = a.y; y <= b.y; ++y)
+      for (int x = a.x; x <= b.x; ++x) {
+        const double dx = lattice_.origin.x + (x + 0.5) * h_ - q.x, dy = lattice_.origin.y + (y + 0.5) * h_ - q.y;
+        const double d = std::sqrt(dx * dx + dy * dy);
+        if (d >= R - 1e-6) continue;
+        const std::size_t i = std::size_t(y - lo.y) * std::size_t(nx) + std::size_t(x - lo.x);
+        bottom[i] = std::min(bottom[i], q.z + shape.height_at(d));
+        top[i] = std::min(top[i], q.z + tool_.flute_length);
+      }
+  };
+  for (std::size_t s = 0; s < pts.size(); ++s) {
+    const Vec3 a = pts[s], b = pts[s + 1 < pts.size() ? s + 1 : s];
+    const int n = std::max(1, int(std::ceil(std::hypot(b.x - a.x, b.y - a.y) / (h_ / 4))));
+    for (int k = 0; k < n; ++k) {
+      const double t = double(k) / n;
+      visit({a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), a.z + t * (b.z - a.z)});
+    }
+    if (s + 1 == pts.size()) visit(b);
+  }
+  for (int y = lo.y; y <= hi.y; ++y)
+    for (int x = lo.x; x <= hi.x; ++x) {
+      const std::size_t i = std::size_t(y - lo.y) * std::size_t(nx) + std::size_t(x - lo.x);
+      if (!std::isfinite(bottom[i])) continue;
+      const int k0 = int(std::ceil((bottom[i] - lattice_.origin.z) / h_ - 0.5 + 1e-9));
+      const int k1 = int(std::floor((top[i] - lattice_.origin.z) / h_ - 0.5 - 1e-9));
+      for (int k = k0; k <= k1; ++k)
+        if (remaining_.contains({x, y, k})) remaining_.set({x, y, k}, false);
+    }
+  refresh_tops({{lo.x, lo.y, 0}, {hi.x + 1, hi.y + 1, 1}});
+}
+
+void PocketBuilder::cut_surface_pass(const std::vector<Vec3>& pts, bool linked) {
+  const Vec3 s = pts.front();
+  std::vector<Vec3> swept;
+  if (linked) {
+    // Over the surface from where the last pass ended: the link's own drop-cutter path.
+    const std::vector<Vec3> link = surface_line({at_.x, at_.y}, {s.x, s.y});
+    for (std::size_t k = 1; k < link.size(); ++k) move(MoveKind::Feed, link[k], tool_.feed, true, k == 1 ? "link" : "");
+    swept = link;
+  } else {
+    retract();
+    go_above(Point2{s.x, s.y}, rapid_stop_at({s.x, s.y}, s.z));
+    move(MoveKind::Feed, s, tool_.plunge_feed, true, "down to the surface");
+    at_level_ = true;
+  }
+  for (std::size_t k = 1; k < pts.size(); ++k) move(MoveKind::Feed, pts[k], tool_.feed, true);
+  swept.insert(swept.end(), pts.begin(), pts.end());
+  stamp_surface_pass(swept);
+  ++surface_passes_;
+}
+
+void PocketBuilder::finish_surfaces() {
+  if (!drop_) return;
+  const CellBox box = cell_bounds(surface_domain_);
+  if (box.empty()) return;
+  const double xa = lattice_.origin.x + box.x0 * h_, xb = lattice_.origin.x + box.x1 * h_ - 1e-6;
+  const double ya = lattice_.origin.y + box.y0 * h_, yb = lattice_.origin.y + box.y1 * h_ - 1e-6;
+  const int rows = std::max(1, int(std::ceil((yb - ya) / surface_step_over_))) + 1;
+  const double dy = (yb - ya) / (rows - 1);
+  const double sample = std::min({0.25, h_ / 2, surface_step_over_});
+  pending_comment_ = "surface finishing: drop-cutter rows " + mm(dy) + " mm apart on the STL";
+  bool forward = true;
+  for (int r = 0; r < rows; ++r) {
+    const double y = ya + r * dy;
+    // The row's stretches over the domain, in the direction of travel.
+    std::vector<std::pair<double, double>> stretches;
+    const int n = std::max(1, int(std::ceil((xb - xa) / sample)));
+    double start = 0;
+    bool inside = false;
+    for (int i = 0; i <= n; ++i) {
+      const double x = xa + (xb - xa) * i / n;
+      const bool in = in_surface_domain({x, y});
+      if (in && !inside) start = x;
+      if (!in && inside) stretches.emplace_back(start, xa + (xb - xa) * (i - 1) / n);
+      inside = in;
+    }
+    if (inside) stretches.emplace_back(start, xb);
+    if (!forward) {
+      std::reverse(stretches.begin(), stretches.end());
+      for (auto& [a, b] : stretches) std::swap(a, b);
+    }
+    for (const auto& [a, b] : stretches) {
+      const std::vector<Vec3> line = surface_line({a, y}, {b, y});
+      // Passes: the line's finite runs (nothing under the cutter, or no room for it, ends one).
+      std::size_t i = 0;
+      while (i < line.size()) {
+        while (i < line.size() && !finite(line[i])) ++i;
+        std::size_t j = i;
+        while (j < line.size() && finite(line[j])) ++j;
+        if (j >= i + 2) {
+          const std::vector<Vec3> pass(line.begin() + std::ptrdiff_t(i), line.begin() + std::ptrdiff_t(j));
+          const double gap = std::hypot(pass.front().x - at_.x, pass.front().y - at_.y);
+          bool linked = at_level_ && gap <= 2 * surface_step_over_ + 1e-9;
+          if (linked)
+            for (const Vec3& q : surface_line({at_.x, at_.y}, {pass.front().x, pass.front().y})) linked = linked && finite(q);
+          cut_surface_pass(pass, linked);
+        }
+        i = j;
+      }
+    }
+    forward = !forward;
+  }
+  retract();
+}
+
+}  // namespace hybridctl::toolpaths::pocket
