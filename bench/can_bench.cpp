@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_main.hpp"
 #include "bench/bench_process.hpp"
 #include "drivers/journal.hpp"
 #include "protocol/chunk.hpp"
@@ -200,4 +201,14 @@ void BM_StreamProgram(benchmark::State& state) {
 BENCHMARK(BM_RawBusFrames)->Arg(640 * 64)->Iterations(3)->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_StreamProgram)->Arg(12000)->Iterations(3)->UseManualTime()->Unit(benchmark::kMillisecond);
 
-BENCHMARK_MAIN();
+namespace {
+
+// --smoke: 640 raw frames, then a program of 500 lines streamed once.
+void register_smoke_cases() {
+  hybridctl::bench::smoke_case("BM_RawBusFrames", BM_RawBusFrames)->Arg(640)->UseManualTime()->Unit(benchmark::kMillisecond);
+  hybridctl::bench::smoke_case("BM_StreamProgram", BM_StreamProgram)->Arg(500)->UseManualTime()->Unit(benchmark::kMillisecond);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return hybridctl::bench::run_benchmarks(argc, argv, register_smoke_cases); }

@@ -6,6 +6,7 @@
 //
 //   BUILD_TARGET=exact_verification_bench scripts/build -DHYBRIDCTL_BUILD_BENCH=ON
 //   build/bench/exact_verification_bench
+//   build/bench/exact_verification_bench --smoke   (the flanged hub's best plan alone)
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -18,10 +19,13 @@
 #include "planner/pipeline/planning.hpp"
 #include "validation/execution.hpp"
 #include "verification/exact_deviation.hpp"
+#include "bench/bench_main.hpp"
 
 namespace {
 
 using namespace hybridctl;
+
+int g_top_k = 0;  // plans per part: 0 as `plan` (its default); 1 for --smoke
 
 double seconds_of(auto&& fn) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -34,8 +38,13 @@ void exact_against_voxels(benchmark::State& state, const std::string& part, cons
   const config::Machine machine = config::load_machine(root + machine_file);
   const geometry::TriangleMesh mesh = geometry::read_stl(root + part);
   planner::PlanningOptions options;
+  if (g_top_k > 0) options.top_k = g_top_k;
   const planner::PlanningResult planned = planner::plan_part(mesh, part, machine, options);
   const plan::PlanFile file = planner::to_plan_file(planned, {part, machine_file, machine.name, ""}, ".");
+  if (file.plans.empty()) {
+    state.SkipWithError((part + " has no plan on " + machine_file).c_str());
+    return;
+  }
   double voxels = 0, exact = 0;
   for (auto _ : state) {
     for (const plan::PlanFilePlan& p : file.plans) {
@@ -67,6 +76,14 @@ BENCHMARK_CAPTURE(exact_against_voxels, boss_plate, "examples/parts/boss-plate.s
     ->Iterations(1)
     ->Unit(benchmark::kSecond);
 
+// --smoke: the flanged hub's best plan, both ways, once.
+void register_smoke_cases() {
+  g_top_k = 1;
+  hybridctl::bench::smoke_case("exact_against_voxels/flanged_hub", [](benchmark::State& state) {
+    exact_against_voxels(state, "examples/parts/flanged-hub.stl", "examples/machines/hybrid-3axis.yaml");
+  })->Unit(benchmark::kSecond);
+}
+
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return hybridctl::bench::run_benchmarks(argc, argv, register_smoke_cases); }

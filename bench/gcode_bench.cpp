@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench_main.hpp"
+
 #include "config/machine_loader.hpp"
 #include "gcode/check.hpp"
 #include "gcode/interpreter.hpp"
@@ -66,8 +68,11 @@ std::vector<ActionProgram> synthetic_actions(int target_moves) {
   return {a};
 }
 
+// The program's moves: 100k, 2,000 for --smoke.
+int g_moves = 100000;
+
 const std::string& program_text() {
-  static const std::string text = write_program(synthetic_actions(100000), machine());
+  static const std::string text = write_program(synthetic_actions(g_moves), machine());
   return text;
 }
 
@@ -94,7 +99,7 @@ BENCHMARK(BM_Parser)->Unit(benchmark::kMillisecond);
 /// Longer lines: every axis, four decimals, a feed and a comment on every tenth line.
 void BM_ParserFullLines(benchmark::State& state) {
   std::vector<std::string> lines;
-  for (int i = 0; i < 100000; ++i) {
+  for (int i = 0; i < g_moves; ++i) {
     char buf[96];
     std::snprintf(buf, sizeof buf, "N%d G1 X%.4f Y%.4f Z%.4f F%d%s", i, (i % 997) * 0.1234, -(i % 313) * 0.5678,
                   (i % 7) * 0.25, 1000 + i % 50, i % 10 == 0 ? " (row)" : "");
@@ -139,7 +144,7 @@ void BM_Check(benchmark::State& state) {
 BENCHMARK(BM_Check)->Unit(benchmark::kMillisecond);
 
 void BM_Writer(benchmark::State& state) {
-  const auto actions = synthetic_actions(100000);
+  const auto actions = synthetic_actions(g_moves);
   std::size_t lines = 0;
   for (auto _ : state) {
     const std::string text = write_program(actions, machine());
@@ -154,4 +159,18 @@ BENCHMARK(BM_Writer)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+
+namespace {
+
+// --smoke: every case once, on a program of 2,000 moves.
+void register_smoke_cases() {
+  g_moves = 2000;
+  for (auto [name, fn] : {hybridctl::bench::NamedCase{"BM_Parser", BM_Parser}, hybridctl::bench::NamedCase{"BM_ParserFullLines", BM_ParserFullLines},
+                          hybridctl::bench::NamedCase{"BM_Interpreter", BM_Interpreter}, hybridctl::bench::NamedCase{"BM_Check", BM_Check},
+                          hybridctl::bench::NamedCase{"BM_Writer", BM_Writer}})
+    hybridctl::bench::smoke_case(name, fn)->Unit(benchmark::kMillisecond);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) { return hybridctl::bench::run_benchmarks(argc, argv, register_smoke_cases); }

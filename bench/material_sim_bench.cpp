@@ -12,6 +12,8 @@
 
 #include <cmath>
 
+#include "bench/bench_main.hpp"
+
 #include "sim/material.hpp"
 
 namespace {
@@ -100,6 +102,16 @@ void BM_BeadMoves(benchmark::State& state) {
 }
 BENCHMARK(BM_BeadMoves)->Arg(50)->Arg(25);
 
+// --smoke: one move of each kind at 10 mm depth, one bead at 0.5 mm.
+void register_smoke_cases() {
+  for (auto [name, fn] : {hybridctl::bench::NamedCase{"BM_FlatLevelX", BM_FlatLevelX}, hybridctl::bench::NamedCase{"BM_FlatLevelDiagonal", BM_FlatLevelDiagonal},
+                          hybridctl::bench::NamedCase{"BM_FlatRamp", BM_FlatRamp}, hybridctl::bench::NamedCase{"BM_BallRamp", BM_BallRamp},
+                          hybridctl::bench::NamedCase{"BM_BullLevel", BM_BullLevel}, hybridctl::bench::NamedCase{"BM_BullRamp", BM_BullRamp}})
+    hybridctl::bench::smoke_case(name, fn)->Arg(10);
+  hybridctl::bench::smoke_case("BM_FlatFullCircle", BM_FlatFullCircle);
+  hybridctl::bench::smoke_case("BM_BeadMoves", BM_BeadMoves)->Arg(50);
+}
+
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return hybridctl::bench::run_benchmarks(argc, argv, register_smoke_cases); }

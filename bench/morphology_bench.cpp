@@ -6,6 +6,8 @@
 
 #include <map>
 
+#include "bench/bench_main.hpp"
+
 #include "geometry/morphology.hpp"
 #include "geometry/shapes.hpp"
 
@@ -59,6 +61,13 @@ BENCHMARK(BM_Ball_Fft)->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMilliseco
 BENCHMARK(BM_FlatMill_Fast)->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FlatMill_Fft)->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// --smoke: each element and method at 64^3, once.
+void register_smoke_cases() {
+  for (auto [name, fn] : {hybridctl::bench::NamedCase{"BM_Ball_Fast", BM_Ball_Fast}, hybridctl::bench::NamedCase{"BM_Ball_Fft", BM_Ball_Fft},
+                          hybridctl::bench::NamedCase{"BM_FlatMill_Fast", BM_FlatMill_Fast}, hybridctl::bench::NamedCase{"BM_FlatMill_Fft", BM_FlatMill_Fft}})
+    hybridctl::bench::smoke_case(name, fn)->Arg(64)->Unit(benchmark::kMillisecond);
+}
+
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return hybridctl::bench::run_benchmarks(argc, argv, register_smoke_cases); }

@@ -17,6 +17,7 @@
 #include "planner/search/search.hpp"
 #include "planner/search/reduce.hpp"
 #include "bench/baseline_astar.hpp"
+#include "bench/bench_main.hpp"
 #include "bench/plan_problem.hpp"
 
 namespace {
@@ -277,6 +278,20 @@ void BM_PlanBracket(benchmark::State& state) {
 
 BENCHMARK(BM_PlanBracket)->Arg(1)->Arg(2)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
+// --smoke: the smallest case of each kind, once: 8 primitives, n = 8 with one seed, the
+// bracket's recorded problem as `plan` searches it, and `plan` at 0.5 mm.
+void register_smoke_cases() {
+  using hybridctl::bench::smoke_case;
+  smoke_case("BM_DecomposeIncremental", BM_DecomposeIncremental)->Arg(8)->Unit(benchmark::kMillisecond);
+  smoke_case("BM_DecomposeRecompute", BM_DecomposeRecompute)->Arg(8)->Unit(benchmark::kMillisecond);
+  smoke_case("BM_AStar", BM_AStar)->Args({8, 11, 2'000'000})->Unit(benchmark::kMillisecond);
+  smoke_case("BM_Search", BM_Search)->Args({8, 11, 1, 2'000'000})->Unit(benchmark::kMillisecond);
+  smoke_case("BM_Exhaustive", BM_Exhaustive)->Args({8, 11})->Unit(benchmark::kMillisecond);
+  smoke_case("BM_SearchMachine", BM_SearchMachine)->Args({0, 0, 0})->Unit(benchmark::kMillisecond);
+  smoke_case("BM_CoreProof", BM_CoreProof)->Arg(0)->Unit(benchmark::kMillisecond);
+  smoke_case("BM_PlanBracket", BM_PlanBracket)->Arg(1)->Unit(benchmark::kSecond);
+}
+
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return hybridctl::bench::run_benchmarks(argc, argv, register_smoke_cases); }

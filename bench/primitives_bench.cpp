@@ -21,6 +21,8 @@
 #include <chrono>
 #include <string>
 
+#include "bench/bench_main.hpp"
+
 #include "config/machine_loader.hpp"
 #include "geometry/mesh.hpp"
 #include "geometry/voxelize.hpp"
@@ -131,6 +133,12 @@ BENCHMARK(BM_MachinePrimitives)->Arg(0)->Arg(1)->Unit(benchmark::kSecond)->UseRe
 BENCHMARK(BM_ReferenceRemovals)->Arg(0)->Arg(1)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 BENCHMARK(BM_GridPhases)->ArgsProduct({{0, 1}, {50, 25}})->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
 
+// --smoke: the grid phases of the bracket at 1 mm (the fast path and the reference have
+// no smaller case than 0.5 mm: job_for's voxel size is theirs).
+void register_smoke_cases() {
+  hybridctl::bench::smoke_case("BM_GridPhases", BM_GridPhases)->Args({0, 100})->Unit(benchmark::kSecond);
+}
+
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return hybridctl::bench::run_benchmarks(argc, argv, register_smoke_cases); }

@@ -5,6 +5,7 @@
 // states, toolpaths, meshes) and writing the page with its snapshots.
 //
 //   build/bench/report_bench [--voxel MM]   (plans once first; that time is not measured)
+//   build/bench/report_bench --smoke        (the page once, of the best plan alone)
 
 #include <benchmark/benchmark.h>
 #include <unistd.h>
@@ -20,6 +21,7 @@
 #include "planner/pipeline/plan_report.hpp"
 #include "report/report.hpp"
 #include "report/report_data.hpp"
+#include "bench/bench_main.hpp"
 
 namespace {
 
@@ -27,6 +29,8 @@ using namespace hybridctl;
 namespace fs = std::filesystem;
 
 double g_voxel = 0.5;
+int g_top_k = 5;  // 1 for --smoke
+bool g_planned = false;
 
 // The plan, planned once: its directory, and the plan as `plan --report` holds it in memory.
 struct Planned {
@@ -37,12 +41,13 @@ struct Planned {
 const Planned& planned() {
   static const Planned p = [] {
     Planned out;
+    g_planned = true;
     out.dir = fs::temp_directory_path() / ("hybridctl-report-bench-" + std::to_string(::getpid()));
     const std::string text = config::read_machine_text(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
     const config::Machine machine = config::parse_machine(text, "hybrid-3axis.yaml");
     planner::PlanningOptions options;
     options.voxel_size = g_voxel;
-    options.top_k = 5;
+    options.top_k = g_top_k;
     const auto start = std::chrono::steady_clock::now();
     const auto result = planner::plan_part(geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/flanged-hub.stl"),
                                            "flanged-hub.stl", machine, options);
@@ -77,6 +82,7 @@ void BM_WriteReport(benchmark::State& state) {
   request.plan = plan_directory();
   report::ReportResult r;
   for (auto _ : state) r = report::write_report(request);
+  if (r.plans == 0) state.SkipWithError("the report has no plan: the flanged hub has none on hybrid-3axis.yaml");
   state.counters["page_MB"] = double(r.bytes) / 1e6;
   state.counters["plans"] = r.plans;
   state.counters["actions"] = r.actions;
@@ -98,14 +104,25 @@ void BM_WriteReportFromMemory(benchmark::State& state) {
 }
 BENCHMARK(BM_WriteReportFromMemory)->Unit(benchmark::kMillisecond)->Iterations(3);
 
+// --smoke: the page written once, of the best plan alone.
+void register_smoke_cases() {
+  g_top_k = 1;
+  hybridctl::bench::smoke_case("BM_WriteReport", BM_WriteReport)->Unit(benchmark::kMillisecond);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  for (int i = 1; i + 1 < argc; ++i)
-    if (std::strcmp(argv[i], "--voxel") == 0) g_voxel = std::atof(argv[i + 1]);
-  benchmark::Initialize(&argc, argv);
-  benchmark::RunSpecifiedBenchmarks();
+  std::vector<char*> args;  // --voxel MM is ours; the rest goes to run_benchmarks
+  for (int i = 0; i < argc; ++i) {
+    if (i > 0 && i + 1 < argc && std::strcmp(argv[i], "--voxel") == 0) {
+      g_voxel = std::atof(argv[++i]);
+      continue;
+    }
+    args.push_back(argv[i]);
+  }
+  const int status = hybridctl::bench::run_benchmarks(int(args.size()), args.data(), register_smoke_cases);
   std::error_code ec;
-  fs::remove_all(plan_directory(), ec);
-  return 0;
+  if (g_planned) fs::remove_all(plan_directory(), ec);
+  return status;
 }

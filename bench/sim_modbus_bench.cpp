@@ -23,6 +23,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "bench/bench_main.hpp"
 #include "bench/bench_process.hpp"
 #include "protocol/chunk.hpp"
 #include "protocol/messages.hpp"
@@ -81,12 +82,13 @@ std::vector<std::string> program(int moves) {
 }
 
 double g_sim_rate = 0, g_bare_rate = 0;
+int g_moves = 400000;  // 2,000 for --smoke
 
 void BM_SimulatorChunksFc23(benchmark::State& state) {
   ChildProcess sim = hybridctl::bench::start_simulator({"--modbus", "tcp://127.0.0.1:0"}, "modbus-tcp");
   pin_to_cpu(0);
   modbus_t* ctx = connect(sim.port);
-  const std::vector<std::string> lines = program(400000);
+  const std::vector<std::string> lines = program(g_moves);
   const std::uint64_t identity = program_identity(lines);
   std::uint16_t command_seq = 0;
   auto command = [&](CommandCode code) {
@@ -164,7 +166,7 @@ void BM_BareLibmodbusFc23(benchmark::State& state) {
 }
 
 // Keeps each benchmark's items/s for the ratio printed at the end.
-class RateReporter : public benchmark::ConsoleReporter {
+class RateReporter : public hybridctl::bench::CheckingReporter {
  public:
   void ReportRuns(const std::vector<Run>& runs) override {
     for (const Run& r : runs) {
@@ -174,7 +176,7 @@ class RateReporter : public benchmark::ConsoleReporter {
       if (name.find("Simulator") != std::string::npos) g_sim_rate = it->second;
       if (name.find("Bare") != std::string::npos) g_bare_rate = it->second;
     }
-    ConsoleReporter::ReportRuns(runs);
+    CheckingReporter::ReportRuns(runs);
   }
 };
 
@@ -183,15 +185,24 @@ class RateReporter : public benchmark::ConsoleReporter {
 BENCHMARK(BM_BareLibmodbusFc23)->MinTime(2.0)->UseRealTime();
 BENCHMARK(BM_SimulatorChunksFc23)->MinTime(2.0)->UseRealTime();
 
+namespace {
+
+// --smoke: 300 chunks each way on a program of 2,000 lines.
+void register_smoke_cases() {
+  g_moves = 2000;
+  hybridctl::bench::smoke_case("BM_BareLibmodbusFc23", BM_BareLibmodbusFc23)->Iterations(300);
+  hybridctl::bench::smoke_case("BM_SimulatorChunksFc23", BM_SimulatorChunksFc23)->Iterations(300);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   std::signal(SIGPIPE, SIG_IGN);
-  benchmark::Initialize(&argc, argv);
   RateReporter reporter;
-  benchmark::RunSpecifiedBenchmarks(&reporter);
+  const int status = hybridctl::bench::run_benchmarks(argc, argv, register_smoke_cases, &reporter);
   if (g_sim_rate > 0 && g_bare_rate > 0) {
     std::printf("\nsimulator / bare libmodbus FC23 (both pinned to CPU %d): %.0f / %.0f requests/s = %.2f\n", hybridctl::bench::kBenchCpu,
                 g_sim_rate, g_bare_rate, g_sim_rate / g_bare_rate);
   }
-  benchmark::Shutdown();
-  return 0;
+  return status;
 }

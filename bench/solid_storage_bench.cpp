@@ -8,6 +8,8 @@
 
 #include <random>
 
+#include "bench/bench_main.hpp"
+
 #include "geometry/openvdb_bridge.hpp"
 #include "geometry/shapes.hpp"
 #include "geometry/voxelize.hpp"
@@ -93,6 +95,15 @@ BENCHMARK(BM_Dense_PointQueries)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_OpenVdb_PointQueries)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Memory)->Iterations(1);
 
+// --smoke: every operation once, on the same operands (the bracket at 0.25 mm).
+void register_smoke_cases() {
+  for (auto [name, fn] : {hybridctl::bench::NamedCase{"BM_Dense_Intersect", BM_Dense_Intersect}, hybridctl::bench::NamedCase{"BM_OpenVdb_Intersect", BM_OpenVdb_Intersect},
+                          hybridctl::bench::NamedCase{"BM_Dense_Union", BM_Dense_Union}, hybridctl::bench::NamedCase{"BM_OpenVdb_Union", BM_OpenVdb_Union},
+                          hybridctl::bench::NamedCase{"BM_Dense_PointQueries", BM_Dense_PointQueries},
+                          hybridctl::bench::NamedCase{"BM_OpenVdb_PointQueries", BM_OpenVdb_PointQueries}, hybridctl::bench::NamedCase{"BM_Memory", BM_Memory}})
+    hybridctl::bench::smoke_case(name, fn)->Unit(benchmark::kMicrosecond);
+}
+
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return hybridctl::bench::run_benchmarks(argc, argv, register_smoke_cases); }

@@ -11,6 +11,8 @@
 
 #include <cmath>
 
+#include "bench/bench_main.hpp"
+
 #include "toolpaths/deposition_path.hpp"
 #include "toolpaths/pocket_path.hpp"
 #include "geometry/shapes.hpp"
@@ -117,6 +119,15 @@ void BM_PocketZigzag_Rougher(benchmark::State& s) { pocket(s, rougher(), toolpat
 void BM_PocketOffsets_Rougher(benchmark::State& s) { pocket(s, rougher(), toolpaths::PocketStrategy::Offsets); }
 void BM_PocketZigzag_Detail(benchmark::State& s) { pocket(s, detail(), toolpaths::PocketStrategy::Zigzag); }
 
+// --smoke: each path once on the same region.
+void register_smoke_cases() {
+  hybridctl::bench::smoke_case("BM_Deposition", BM_Deposition)->Arg(0)->Unit(benchmark::kMillisecond);
+  for (auto [name, fn] : {hybridctl::bench::NamedCase{"BM_PocketZigzag_Rougher", BM_PocketZigzag_Rougher},
+                          hybridctl::bench::NamedCase{"BM_PocketOffsets_Rougher", BM_PocketOffsets_Rougher},
+                          hybridctl::bench::NamedCase{"BM_PocketZigzag_Detail", BM_PocketZigzag_Detail}})
+    hybridctl::bench::smoke_case(name, fn)->Unit(benchmark::kMillisecond);
+}
+
 }  // namespace
 
 BENCHMARK(BM_Deposition)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -124,4 +135,4 @@ BENCHMARK(BM_PocketZigzag_Rougher)->Unit(benchmark::kMillisecond)->UseRealTime()
 BENCHMARK(BM_PocketOffsets_Rougher)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_PocketZigzag_Detail)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return hybridctl::bench::run_benchmarks(argc, argv, register_smoke_cases); }

@@ -28,6 +28,7 @@
 #include "protocol/messages.hpp"
 #include "protocol/modbus_map.hpp"
 #include "drivers/transport.hpp"
+#include "bench/bench_main.hpp"
 
 namespace {
 
@@ -54,8 +55,10 @@ std::vector<std::string> program(int moves) {
   return program_lines(p);
 }
 
+int g_moves = 200000;  // 2,000 for --smoke
+
 const std::vector<std::string>& lines() {
-  static const std::vector<std::string> l = program(200000);
+  static const std::vector<std::string> l = program(g_moves);
   return l;
 }
 
@@ -176,7 +179,7 @@ void BM_BareLibmodbusFc23(benchmark::State& state) {
 }
 
 // Keeps each benchmark's rates for the ratio printed at the end.
-class RateReporter : public benchmark::ConsoleReporter {
+class RateReporter : public hybridctl::bench::CheckingReporter {
  public:
   void ReportRuns(const std::vector<Run>& runs) override {
     for (const Run& r : runs) {
@@ -185,7 +188,7 @@ class RateReporter : public benchmark::ConsoleReporter {
       if (auto it = r.counters.find("requests/s"); it != r.counters.end()) rates->requests = it->second;
       if (auto it = r.counters.find("lines/s"); it != r.counters.end()) rates->lines = it->second;
     }
-    ConsoleReporter::ReportRuns(runs);
+    CheckingReporter::ReportRuns(runs);
   }
 };
 
@@ -194,17 +197,26 @@ class RateReporter : public benchmark::ConsoleReporter {
 BENCHMARK(BM_BareLibmodbusFc23)->MinTime(2.0)->UseRealTime();
 BENCHMARK(BM_TransportSendChunk)->MinTime(2.0)->UseRealTime();
 
+namespace {
+
+// --smoke: 300 chunks each way on a program of 2,000 lines.
+void register_smoke_cases() {
+  g_moves = 2000;
+  hybridctl::bench::smoke_case("BM_BareLibmodbusFc23", BM_BareLibmodbusFc23)->Iterations(300);
+  hybridctl::bench::smoke_case("BM_TransportSendChunk", BM_TransportSendChunk)->Iterations(300);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   std::signal(SIGPIPE, SIG_IGN);
-  benchmark::Initialize(&argc, argv);
   RateReporter reporter;
-  benchmark::RunSpecifiedBenchmarks(&reporter);
+  const int status = hybridctl::bench::run_benchmarks(argc, argv, register_smoke_cases, &reporter);
   if (g_transport.requests > 0 && g_bare.requests > 0) {
     std::printf("\nModbusTransport::send_chunk / bare libmodbus FC23, same simulator, both pinned to CPU %d:\n", hybridctl::bench::kBenchCpu);
     std::printf("  %.0f / %.0f requests/s = %.2f\n", g_transport.requests, g_bare.requests,
                 g_transport.requests / g_bare.requests);
     std::printf("  %.0f / %.0f lines/s (~28-byte lines, chunks up to 222 bytes)\n", g_transport.lines, g_bare.lines);
   }
-  benchmark::Shutdown();
-  return 0;
+  return status;
 }

@@ -4,6 +4,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include "bench/bench_main.hpp"
+
 #include "geometry/voxelize.hpp"
 
 namespace {
@@ -36,6 +38,12 @@ void BM_OpenVdbLevelSet(benchmark::State& state) { voxelize_bracket(state, Voxel
 BENCHMARK(BM_ExactScan)->Arg(1)->Arg(2)->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_OpenVdbLevelSet)->Arg(1)->Arg(2)->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// --smoke: both methods at 0.5 mm, once.
+void register_smoke_cases() {
+  hybridctl::bench::smoke_case("BM_ExactScan", BM_ExactScan)->Arg(1)->Unit(benchmark::kMillisecond);
+  hybridctl::bench::smoke_case("BM_OpenVdbLevelSet", BM_OpenVdbLevelSet)->Arg(1)->Unit(benchmark::kMillisecond);
+}
+
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) { return hybridctl::bench::run_benchmarks(argc, argv, register_smoke_cases); }
