@@ -127,8 +127,9 @@ class PocketBuilder {
   // material over its cells.
   double ramp_start(Cell b, Cell d, int m, double zk) const;
 
-  // Wall finishing (pocket_finish.cpp). Whether this run finishes walls, and what it needs.
-  void start_finishing(const Solid& roi, const Solid* design);
+  // Wall finishing (pocket_finish.cpp). Whether this run finishes walls, and what it needs;
+  // `region`: what the action may remove (the walls next to it are finished).
+  void start_finishing(const Solid& region, const Solid* design);
   // The tip positions at height z where the tool would cut into the design.
   TipKeepOut keep_out_at(double z) const;
   // The cells of the tip domain whose centres lie in `region` (boundary included).
@@ -200,7 +201,7 @@ class PocketBuilder {
   bool finishing_ = false;
   std::vector<ToolBand> finish_bands_;
   double rough_margin_ = 0;  // mm the roughing's tips keep beyond the keep-out region
-  Solid roi_, design_;       // work frame
+  Solid roi_, design_;       // work frame; roi_: what the action may remove (finishing)
   std::vector<double> face_heights_;  // of the design's faces square to the axis, top-down
   // Surface finishing.
   std::shared_ptr<const DropCutter> drop_;

@@ -94,7 +94,7 @@ struct FinishRun {
   bool closed = false;  // a whole loop: it may start anywhere
 };
 
-void PocketBuilder::start_finishing(const Solid& roi, const Solid* design) {
+void PocketBuilder::start_finishing(const Solid& region, const Solid* design) {
   finishing_ = false;
   if (!options_.finish_walls || !options_.design || options_.design->empty() || tool_.type != config::ToolType::Flat)
     return;
@@ -103,7 +103,7 @@ void PocketBuilder::start_finishing(const Solid& roi, const Solid* design) {
                                         geometry::VoxelizeMethod::ExactScan);
   finish_bands_ = flat_tool_bands(tool_);
   if (finish_bands_.empty()) return;
-  roi_ = roi;
+  roi_ = region;
   // The heights of the design's faces square to the tool axis, either way up: where a wall
   // ends, finished from there when no level is (the flange's rim above the stock kept
   // under it: the level below would reach into that stock).
@@ -346,7 +346,7 @@ std::optional<FinishLevel> PocketBuilder::finish_level(const TipKeepOut& keep_ou
   auto layer_of = [&](double height) { return (height - lattice_.origin.z) / h_ - 0.5; };
   // The layers whose centres the cutter holds.
   const int c0 = int(std::ceil(layer_of(z) - 1e-9)), c1 = int(std::floor(layer_of(z + tool_.flute_length) + 1e-9));
-  // Where a pass is this level's: near the ROI the level removes (its layers [k, k_above))
+  // Where a pass is this level's: near what the level may remove (the region's layers [k, k_above))
   // and near design material kept at the cutter's layers. Other walls are other levels' or
   // other actions'. The design's voxels have their centres inside the STL, which the
   // keep-out region keeps the cutter off: what it must not hold is what stays besides.

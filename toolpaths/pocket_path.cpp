@@ -408,7 +408,9 @@ Toolpath& PocketBuilder::run(const Solid& roi, const Solid& keep, const Solid& s
   start_column_tops();
   const Levels levels = cutting_levels();
   level_heights_ = exact_heights(levels);
-  start_finishing(roi, design);
+  // The faces an action finishes are those next to what it may remove, also where an
+  // earlier action left less than a voxel on them.
+  start_finishing(finish_region ? *finish_region : roi, design);
   start_surface_finishing(finish_region ? *finish_region : roi, design);
   int level_number = 0;
   int k_above = rb.hi.z;  // the ROI's layers [k, k_above) are level k's to remove

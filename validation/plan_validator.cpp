@@ -24,6 +24,10 @@ struct ExactFailure {
   bool excess = true;  // material out of the surface (else a gouge)
   geometry::Vec3 at;
   double mm = 0;
+  // An excess where nothing deposits: the candidate's first action (its stock) and the
+  // removals whose regions reach the place; empty when a deposit reaches it.
+  std::vector<int> cutters;
+  int stock = -1;
 };
 
 // Whether `region` holds a voxel next to the one at `at` (26-neighbourhood, itself included).
@@ -43,6 +47,21 @@ bool reaches(const geometry::Solid& region, geometry::Vec3 at) {
 // change that place (no removal reaches an excess, no deposit a gouge).
 bool repeats(const ExactFailure& f, const plan::PlanFile& file, const plan::PlanFilePlan& candidate) {
   const auto& actions = candidate.actions;
+  // An excess where only removals reach: what stays there is the stock less what they
+  // sweep, so a candidate from the same stock whose removals reaching it are among the
+  // failed one's leaves at least as much (up to toolpaths that differ with the material
+  // they meet: a judgement, not a proof, which spares executing the same tools' failure on
+  // a face again in every order).
+  if (f.excess && f.stock >= 0 && !actions.empty() && actions.front().primitive == f.stock) {
+    bool among = true;
+    for (std::size_t i = 1; i < actions.size() && among; ++i) {
+      const plan::PlanFilePrimitive& p = file.primitives.at(std::size_t(actions[i].primitive));
+      if (!reaches(p.region, f.at)) continue;
+      among = p.mode == config::Mode::Subtractive &&
+              std::find(f.cutters.begin(), f.cutters.end(), actions[i].primitive) != f.cutters.end();
+    }
+    if (among) return true;
+  }
   if (actions.size() < f.prefix.size() ||
       !std::equal(f.prefix.begin(), f.prefix.end(), actions.begin(),
                   [](int p, const plan::PlanFileAction& a) { return p == a.primitive; }))
@@ -119,11 +138,10 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
       if (repeats(f, file, candidate)) {
         plan::CandidateRun known;
         known.reasons = {{f.excess ? "exact_excess" : "exact_gouge", 0, 0,
-                          "not executed: its first " + std::to_string(f.prefix.size()) +
-                              " actions left the part " + fixed_number(f.mm, 3) + " mm " +
+                          "not executed: a candidate executed before left the part " + fixed_number(f.mm, 3) + " mm " +
                               (f.excess ? "out of" : "inside") + " the design's surface at (" + fixed_number(f.at.x, 2) +
                               ", " + fixed_number(f.at.y, 2) + ", " + fixed_number(f.at.z, 2) +
-                              ") mm in a candidate executed before, and nothing after them reaches that place",
+                              ") mm, and this one reaches that place with none but the same actions",
                           f.at}};
         return known;
       }
@@ -151,8 +169,18 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
           const bool excess = run.exact->excess.mm >= run.exact->gouge.mm;
           const plan::ExactPlace& place = excess ? run.exact->excess : run.exact->gouge;
           if (place.at && place.action >= 1 && std::size_t(place.action) <= candidate.actions.size()) {
-            ExactFailure f{{}, excess, *place.at, place.mm};
+            ExactFailure f{{}, excess, *place.at, place.mm, {}, -1};
             for (int k = 0; k < place.action; ++k) f.prefix.push_back(candidate.actions[std::size_t(k)].primitive);
+            bool deposited = false;
+            for (std::size_t k = 1; k < candidate.actions.size(); ++k) {
+              const plan::PlanFilePrimitive& p = file.primitives.at(std::size_t(candidate.actions[k].primitive));
+              if (!reaches(p.region, f.at)) continue;
+              if (p.mode == config::Mode::Subtractive)
+                f.cutters.push_back(candidate.actions[k].primitive);
+              else
+                deposited = true;
+            }
+            if (excess && !deposited && !candidate.actions.empty()) f.stock = candidate.actions.front().primitive;
             state->exact_failed.push_back(std::move(f));
           }
         }
