@@ -71,6 +71,29 @@ TEST_F(WholePlan, TheTubeOnAPlateAtTheMachinesToleranceIsMilledFromTheBlockWithI
   EXPECT_EQ(r.out.find("at least"), std::string::npos) << r.out;  // no lip of the margin
 }
 
+// The rounded box with its shallow spherical dimple on the B-axis machine at its 0.3 mm:
+// the 10 mm bull nose's flat bottom bridges the dimple's bottom (the sphere of 20 mm lies
+// 0.4 mm under a flat 8 mm across), so its finishing leaves 0.52 mm there, and validation
+// turns down the candidates that reach the dimple with no other tools than that one's
+// (docs/validation.md) until the 8 mm ball finishes it on the STL (docs/toolpaths.md,
+// "Surface finishing"); the flat cutters finish the rounded edges that side actions left
+// staircased.
+TEST_F(WholePlan, TheRoundedBoxsDimpleIsFinishedByTheBallOnTheBAxisMachine) {
+  const Outcome r = run({"plan", kParts + "rounded-box-dimple.stl", "--machine", kBAxisMachine, "--top", "1"});
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  EXPECT_NE(r.out.find("  1. ((((P2 \u2212 P15) \u2212 P23) \u2212 P31) \u2212 "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("this one reaches that place with none but the same actions"), std::string::npos) << r.out;
+  const std::smatch m = [&] {
+    std::smatch found;
+    static const std::regex excess(R"(exact:     excess (\d+\.\d+) mm at .*gouge (\d+\.\d+) mm)");
+    std::regex_search(r.out, found, excess);
+    return found;
+  }();
+  ASSERT_EQ(m.size(), 3u) << r.out;
+  EXPECT_LE(std::stod(m[1]), 0.1) << r.out;
+  EXPECT_LE(std::stod(m[2]), 0.1) << r.out;
+}
+
 // A block with a closed channel whose pointed roof builds without support: every plan
 // offered mills the block up to the channel's floor and deposits only the band above it
 // (docs/bands.md), and each one, exported and run on its own simulated controller from the
