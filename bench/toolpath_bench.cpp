@@ -4,18 +4,24 @@
 //     a contour pass;
 //   - Z-level pocketing of a 50 x 50 x 50 mm pocket around a round boss with the bundled
 //     10 mm flat rougher (5 mm step down, 4 mm step over, 42 mm holder), zigzag and
-//     contour-parallel rings, and with the 3 mm flat detail tool (1 mm step down).
+//     contour-parallel rings, and with the 3 mm flat detail tool (1 mm step down);
+//   - the bundled rounded box with its dimple milled from a block over it by the B-axis
+//     machine's 8 mm ball (0.4 mm step down), Z-levels alone (arg 0) and with surface
+//     finishing on the STL at a 0.1 mm scallop (arg 1): their ratio is what finishing adds.
 // Counters: moves, cutting/deposition path length (mm), ROI voxels.
 
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <memory>
 
 #include "bench/bench_main.hpp"
 
 #include "toolpaths/deposition_path.hpp"
 #include "toolpaths/pocket_path.hpp"
+#include "geometry/mesh.hpp"
 #include "geometry/shapes.hpp"
+#include "geometry/voxelize.hpp"
 
 namespace {
 
@@ -115,6 +121,37 @@ void pocket(benchmark::State& state, const config::CuttingTool& tool, toolpaths:
   count(state, p, roi);
 }
 
+void BM_BallOnTheRoundedBox(benchmark::State& state) {
+  const auto mesh = std::make_shared<const std::vector<geometry::Triangle>>(
+      geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/rounded-box-dimple.stl").triangles);
+  const Solid design = geometry::voxelize(geometry::TriangleMesh{*mesh}, kLattice, "rounded box");
+  const Solid stock = geometry::make_box(kLattice, {{0, 0, 0}, {50, 40, 22}});
+  const Solid roi = geometry::subtract(stock, design);
+  config::CuttingTool ball;
+  ball.number = 3;
+  ball.name = "8 mm ball finisher";
+  ball.type = config::ToolType::Ball;
+  ball.diameter = 8;
+  ball.flute_length = 16;
+  ball.shank = {8, 50};
+  ball.holder = {50, 80};
+  ball.feed = 1600;
+  ball.plunge_feed = 400;
+  ball.step_down = 0.4;
+  ball.step_over = 0.5;
+  toolpaths::PocketOptions o;
+  o.design = mesh;
+  o.design_voxels = &design;
+  o.finish_surfaces = state.range(0) != 0;
+  o.scallop = 0.1;
+  gcode::Toolpath p;
+  for (auto _ : state) {
+    p = toolpaths::pocket_path(roi, design, stock, ball, top(), o);
+    benchmark::DoNotOptimize(p.moves.data());
+  }
+  count(state, p, roi);
+}
+
 void BM_PocketZigzag_Rougher(benchmark::State& s) { pocket(s, rougher(), toolpaths::PocketStrategy::Zigzag); }
 void BM_PocketOffsets_Rougher(benchmark::State& s) { pocket(s, rougher(), toolpaths::PocketStrategy::Offsets); }
 void BM_PocketZigzag_Detail(benchmark::State& s) { pocket(s, detail(), toolpaths::PocketStrategy::Zigzag); }
@@ -126,6 +163,7 @@ void register_smoke_cases() {
                           hybridctl::bench::NamedCase{"BM_PocketOffsets_Rougher", BM_PocketOffsets_Rougher},
                           hybridctl::bench::NamedCase{"BM_PocketZigzag_Detail", BM_PocketZigzag_Detail}})
     hybridctl::bench::smoke_case(name, fn)->Unit(benchmark::kMillisecond);
+  hybridctl::bench::smoke_case("BM_BallOnTheRoundedBox", BM_BallOnTheRoundedBox)->Arg(1)->Unit(benchmark::kMillisecond);
 }
 
 }  // namespace
@@ -134,5 +172,6 @@ BENCHMARK(BM_Deposition)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseReal
 BENCHMARK(BM_PocketZigzag_Rougher)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_PocketOffsets_Rougher)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_PocketZigzag_Detail)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_BallOnTheRoundedBox)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 int main(int argc, char** argv) { return hybridctl::bench::run_benchmarks(argc, argv, register_smoke_cases); }

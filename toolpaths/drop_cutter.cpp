@@ -110,6 +110,10 @@ double DropCutter::tip_height(Point2 p) const {
     const double sq = std::sqrt(disc);
     double lo = std::max(0.0, (-wd - sq) / l2), hi = std::min(1.0, (-wd + sq) / l2);
     if (!(lo < hi)) return;
+    // No higher than the edge's top less the lower surface at its nearest approach (f
+    // increases with the distance): most edges are settled here.
+    const double nearest = (w + std::clamp(-wd / l2, lo, hi) * dir).norm();
+    if (std::max(a.z(), b.z()) - shape_.height_at(std::min(R, nearest)) <= best) return;
     auto g = [&](double t) {
       const double d = std::min(R, (w + t * dir).norm());
       return a.z() + t * (b.z() - a.z()) - shape_.height_at(d);

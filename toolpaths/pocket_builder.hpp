@@ -206,6 +206,9 @@ class PocketBuilder {
   // Surface finishing.
   std::shared_ptr<const DropCutter> drop_;
   std::vector<int> obstacle_tops_;  // over tops_box_: what must stay that is not design
+  // Over tops_box_: the highest of those within the cutter's reach, and of all material
+  // within the whole tool's, when finishing starts.
+  std::vector<int> obstacle_near_, material_near_;
   SliceMask surface_domain_;        // tip cells whose passes finish this region's faces
   double surface_step_over_ = 0;    // mm between rows
   double surface_floor_ = 0;        // mm: the region's bottom, below which no pass goes

@@ -27,6 +27,25 @@ constexpr double kRoughLeave = 0.01;
 
 bool finite(const geometry::Vec3& p) { return std::isfinite(p.z); }
 
+// The highest of `tops` (nx by ny cells, row-major) within `r` cells of each cell, square
+// neighbourhood: a bound that spares the exact contact wherever it is below the tool.
+std::vector<int> max_within(const std::vector<int>& tops, int nx, int ny, int r) {
+  std::vector<int> rows(tops.size(), kNoVoxel), out(tops.size(), kNoVoxel);
+  for (int y = 0; y < ny; ++y)
+    for (int x = 0; x < nx; ++x) {
+      int m = kNoVoxel;
+      for (int d = std::max(0, x - r); d <= std::min(nx - 1, x + r); ++d) m = std::max(m, tops[std::size_t(y) * std::size_t(nx) + std::size_t(d)]);
+      rows[std::size_t(y) * std::size_t(nx) + std::size_t(x)] = m;
+    }
+  for (int y = 0; y < ny; ++y)
+    for (int x = 0; x < nx; ++x) {
+      int m = kNoVoxel;
+      for (int d = std::max(0, y - r); d <= std::min(ny - 1, y + r); ++d) m = std::max(m, rows[std::size_t(d) * std::size_t(nx) + std::size_t(x)]);
+      out[std::size_t(y) * std::size_t(nx) + std::size_t(x)] = m;
+    }
+  return out;
+}
+
 }  // namespace
 
 void PocketBuilder::start_surface_finishing(const Solid& region, const Solid* design) {
@@ -43,6 +62,10 @@ void PocketBuilder::start_surface_finishing(const Solid& region, const Solid* de
   // What must stay is an obstacle on the voxels, except the design's own voxels: the
   // design is the STL, and its voxels reach up to half a voxel past it.
   obstacle_tops_ = column_top_indices(geometry::subtract(untouchable_, design_), tops_box_);
+  const int tnx = tops_box_.hi.x - tops_box_.lo.x, tny = tops_box_.hi.y - tops_box_.lo.y;
+  obstacle_near_ = max_within(obstacle_tops_, tnx, tny, int(std::ceil(shape.radius / h_)) + 1);
+  // Material only goes from here on: the highest now bounds it for the whole run.
+  material_near_ = max_within(tops_, tnx, tny, int(std::ceil(model_.max_radius / h_)) + 1);
   // The faces this region lies on: columns where a voxel of the region touches a design
   // voxel (a face's neighbour, below included), and the tip positions whose cutter reaches
   // them; within the tip domain (the ROI's, where the material is known).
@@ -95,11 +118,21 @@ SliceMask PocketBuilder::under_surface(double z) const {
 bool PocketBuilder::in_surface_domain(Point2 p) const { return surface_domain_.at(cell_of(p)); }
 
 double PocketBuilder::surface_tip_at(Point2 p) const {
-  const double under = std::max(drop_->tip_height(p), contact_height_at(p, Part::Cutter, obstacle_tops_));
+  const Cell c = cell_of(p);
+  if (c.x < tops_box_.lo.x || c.y < tops_box_.lo.y || c.x >= tops_box_.hi.x || c.y >= tops_box_.hi.y) return kInf;
+  const std::size_t i = std::size_t(c.y - tops_box_.lo.y) * std::size_t(tops_box_.hi.x - tops_box_.lo.x) +
+                        std::size_t(c.x - tops_box_.lo.x);
+  double under = drop_->tip_height(p);
+  // The cutter holds nothing below its tip, the body nothing below the flutes' top: the
+  // exact contacts only where something near stands that high.
+  if (obstacle_near_[i] != kNoVoxel && centre_z(obstacle_near_[i]) >= under - 1e-9)
+    under = std::max(under, contact_height_at(p, Part::Cutter, obstacle_tops_));
   // Over air, or hanging past an edge further down than the region goes: nothing of this
   // region to finish there, and no call to go down beside the part.
   if (under < surface_floor_ - 1e-9) return -kInf;
-  return std::max(under, contact_height_at(p, Part::Body));
+  if (material_near_[i] != kNoVoxel && centre_z(material_near_[i]) >= under + tool_.flute_length - model_.profile_step - 1e-6)
+    under = std::max(under, contact_height_at(p, Part::Body));
+  return under;
 }
 
 std::vector<geometry::Vec3> PocketBuilder::surface_line(Point2 a, Point2 b) const {
@@ -182,7 +215,7 @@ void PocketBuilder::stamp_surface_pass(const std::vector<Vec3>& pts) {
   };
   for (std::size_t s = 0; s < pts.size(); ++s) {
     const Vec3 a = pts[s], b = pts[s + 1 < pts.size() ? s + 1 : s];
-    const int n = std::max(1, int(std::ceil(std::hypot(b.x - a.x, b.y - a.y) / (h_ / 4))));
+    const int n = std::max(1, int(std::ceil(std::hypot(b.x - a.x, b.y - a.y) / (h_ / 2))));
     for (int k = 0; k < n; ++k) {
       const double t = double(k) / n;
       visit({a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), a.z + t * (b.z - a.z)});
