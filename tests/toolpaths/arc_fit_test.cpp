@@ -433,7 +433,7 @@ TEST(ArcFit, ImpossibleOptionsAreRefused) {
 // their start and end radii agree within 0.0003 mm, on arcs whose points are not on
 // the 0.0001 mm grid.
 TEST(ArcFit, PostedArcsKeepTheirCentreAndRadiusToTheProgramsFourDecimals) {
-  const config::Machine machine = config::load_machine("examples/machines/hybrid-3axis.yaml");
+  const config::Machine machine = config::load_machine(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
   const config::CuttingTool& tool = machine.tools.front();
   ActionProgram action;
   action.action = 1;
