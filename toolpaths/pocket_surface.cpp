@@ -144,13 +144,16 @@ std::vector<geometry::Vec3> PocketBuilder::surface_line(Point2 a, Point2 b) cons
   const double sample = std::min({0.25, h_ / 2, surface_step_over_});
   const int n = std::max(1, int(std::ceil(length / sample)));
   std::vector<Vec3> dense{at(0)};
-  // Where the chord between two samples passes under the surface at their middle, the
-  // middle joins the path, and so on down to kMaxRefinement halvings.
+  // Where the chord between two samples passes under the surface at their middle, or
+  // more than kThinning over it, the middle joins the path, and so on down to
+  // kMaxRefinement halvings.
   auto refine = [&](auto&& self, double t0, const Vec3& p0, double t1, const Vec3& p1, int depth) -> void {
     if (depth >= kMaxRefinement || !finite(p0) || !finite(p1)) return;
     const double tm = (t0 + t1) / 2;
     const Vec3 m = at(tm);
-    if (finite(m) && m.z <= (p0.z + p1.z) / 2 + kChordGouge) return;
+    // Under the chord too: in a hollow the tip's height is convex, and a chord over a
+    // steep stretch of it would leave what it passes over.
+    if (finite(m) && m.z <= (p0.z + p1.z) / 2 + kChordGouge && m.z >= (p0.z + p1.z) / 2 - kThinning) return;
     self(self, t0, p0, tm, m, depth + 1);
     dense.push_back(m);
     self(self, tm, m, t1, p1, depth + 1);
