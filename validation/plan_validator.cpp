@@ -72,6 +72,40 @@ bool repeats(const ExactFailure& f, const plan::PlanFile& file, const plan::Plan
   });
 }
 
+// Where `candidate` left the part beyond the tolerance against the STL (`exact`), as the
+// skip rule above keeps it; nothing when the place is not known.
+std::optional<ExactFailure> failure_of(const plan::PlanFile& file, const plan::PlanFilePlan& candidate,
+                                       const plan::ExactDeviation& exact) {
+  const bool excess = exact.excess.mm >= exact.gouge.mm;
+  const plan::ExactPlace& place = excess ? exact.excess : exact.gouge;
+  if (!place.at || place.action < 1 || std::size_t(place.action) > candidate.actions.size()) return std::nullopt;
+  ExactFailure f{{}, excess, *place.at, place.mm, {}, -1};
+  for (int k = 0; k < place.action; ++k) f.prefix.push_back(candidate.actions[std::size_t(k)].primitive);
+  bool deposited = false;
+  for (std::size_t k = 1; k < candidate.actions.size(); ++k) {
+    const plan::PlanFilePrimitive& p = file.primitives.at(std::size_t(candidate.actions[k].primitive));
+    if (!reaches(p.region, f.at)) continue;
+    if (p.mode == config::Mode::Subtractive)
+      f.cutters.push_back(candidate.actions[k].primitive);
+    else
+      deposited = true;
+  }
+  if (excess && !deposited && !candidate.actions.empty()) f.stock = candidate.actions.front().primitive;
+  return f;
+}
+
+// The rejection of a candidate that repeats `f`, unexecuted.
+plan::CandidateRun repeated(const ExactFailure& f) {
+  plan::CandidateRun known;
+  known.reasons = {{f.excess ? "exact_excess" : "exact_gouge", 0, 0,
+                    "not executed: a candidate executed before left the part " + fixed_number(f.mm, 3) + " mm " +
+                        (f.excess ? "out of" : "inside") + " the design's surface at (" + fixed_number(f.at.x, 2) + ", " +
+                        fixed_number(f.at.y, 2) + ", " + fixed_number(f.at.z, 2) +
+                        ") mm, and this one reaches that place with none but the same actions",
+                    f.at}};
+  return known;
+}
+
 // Minutes per action of an execution that ran to its end: each action's own program under
 // the time model of `gcode check`.
 std::vector<double> action_minutes(const Execution& run, const config::Machine& machine) {
@@ -135,16 +169,7 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
         return known;
       }
     for (const ExactFailure& f : state->exact_failed)
-      if (repeats(f, file, candidate)) {
-        plan::CandidateRun known;
-        known.reasons = {{f.excess ? "exact_excess" : "exact_gouge", 0, 0,
-                          "not executed: a candidate executed before left the part " + fixed_number(f.mm, 3) + " mm " +
-                              (f.excess ? "out of" : "inside") + " the design's surface at (" + fixed_number(f.at.x, 2) +
-                              ", " + fixed_number(f.at.y, 2) + ", " + fixed_number(f.at.z, 2) +
-                              ") mm, and this one reaches that place with none but the same actions",
-                          f.at}};
-        return known;
-      }
+      if (repeats(f, file, candidate)) return repeated(f);
     if (!state->exact_passed && state->exact_failures >= kExactFailuresBeforeGivingUp) {
       plan::CandidateRun skipped;
       skipped.reasons = {{"not_verified", 0, 0,
@@ -166,23 +191,7 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
           const double off = std::max(run.exact->excess.mm, run.exact->gouge.mm);
           state->closest_mm = state->exact_failures == 0 ? off : std::min(state->closest_mm, off);
           ++state->exact_failures;
-          const bool excess = run.exact->excess.mm >= run.exact->gouge.mm;
-          const plan::ExactPlace& place = excess ? run.exact->excess : run.exact->gouge;
-          if (place.at && place.action >= 1 && std::size_t(place.action) <= candidate.actions.size()) {
-            ExactFailure f{{}, excess, *place.at, place.mm, {}, -1};
-            for (int k = 0; k < place.action; ++k) f.prefix.push_back(candidate.actions[std::size_t(k)].primitive);
-            bool deposited = false;
-            for (std::size_t k = 1; k < candidate.actions.size(); ++k) {
-              const plan::PlanFilePrimitive& p = file.primitives.at(std::size_t(candidate.actions[k].primitive));
-              if (!reaches(p.region, f.at)) continue;
-              if (p.mode == config::Mode::Subtractive)
-                f.cutters.push_back(candidate.actions[k].primitive);
-              else
-                deposited = true;
-            }
-            if (excess && !deposited && !candidate.actions.empty()) f.stock = candidate.actions.front().primitive;
-            state->exact_failed.push_back(std::move(f));
-          }
+          if (std::optional<ExactFailure> f = failure_of(file, candidate, *run.exact)) state->exact_failed.push_back(*f);
         }
       }
       if (run.stopped_after > 0) {
