@@ -169,7 +169,9 @@ class PocketBuilder {
   // The tip cells where roughing at height z would come closer to the STL than it leaves
   // for the finishing passes (none when the run does not finish surfaces).
   SliceMask under_surface(double z) const;
-  void cut_surface_pass(const std::vector<Vec3>& pts, bool linked);
+  // One pass along `pts`, reached along `link` from where the tool is (over the surface),
+  // or from above when `link` is empty.
+  void cut_surface_pass(const std::vector<Vec3>& pts, const std::vector<Vec3>& link);
   // Removes from the material still there what the cutter takes along `pts`.
   void stamp_surface_pass(const std::vector<Vec3>& pts);
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "geometry/sliding_extremum.hpp"
 #include "geometry/voxelize.hpp"
 #include "toolpaths/pocket_builder.hpp"
 
@@ -29,20 +30,25 @@ bool finite(const geometry::Vec3& p) { return std::isfinite(p.z); }
 
 // The highest of `tops` (nx by ny cells, row-major) within `r` cells of each cell, square
 // neighbourhood: a bound that spares the exact contact wherever it is below the tool.
+// Rows, then columns, each a sliding maximum over 2r + 1 cells padded with kNoVoxel.
 std::vector<int> max_within(const std::vector<int>& tops, int nx, int ny, int r) {
-  std::vector<int> rows(tops.size(), kNoVoxel), out(tops.size(), kNoVoxel);
+  const int block = 2 * r + 1;
+  std::vector<int> padded, from_start, to_end;
+  auto slide = [&](int n, auto&& at, auto&& put) {
+    padded.assign(std::size_t(n + 2 * r), kNoVoxel);
+    for (int i = 0; i < n; ++i) padded[std::size_t(i + r)] = at(i);
+    from_start.resize(padded.size());
+    to_end.resize(padded.size());
+    const auto pick = [](int a, int b) { return std::max(a, b); };
+    geometry::block_extrema(padded.data(), int(padded.size()), block, from_start.data(), to_end.data(), pick);
+    for (int i = 0; i < n; ++i) put(i, geometry::window_extremum(from_start.data(), to_end.data(), i, block, pick));
+  };
+  std::vector<int> rows(tops.size()), out(tops.size());
+  auto cell = [nx](int x, int y) { return std::size_t(y) * std::size_t(nx) + std::size_t(x); };
   for (int y = 0; y < ny; ++y)
-    for (int x = 0; x < nx; ++x) {
-      int m = kNoVoxel;
-      for (int d = std::max(0, x - r); d <= std::min(nx - 1, x + r); ++d) m = std::max(m, tops[std::size_t(y) * std::size_t(nx) + std::size_t(d)]);
-      rows[std::size_t(y) * std::size_t(nx) + std::size_t(x)] = m;
-    }
-  for (int y = 0; y < ny; ++y)
-    for (int x = 0; x < nx; ++x) {
-      int m = kNoVoxel;
-      for (int d = std::max(0, y - r); d <= std::min(ny - 1, y + r); ++d) m = std::max(m, rows[std::size_t(d) * std::size_t(nx) + std::size_t(x)]);
-      out[std::size_t(y) * std::size_t(nx) + std::size_t(x)] = m;
-    }
+    slide(nx, [&](int x) { return tops[cell(x, y)]; }, [&](int x, int m) { rows[cell(x, y)] = m; });
+  for (int x = 0; x < nx; ++x)
+    slide(ny, [&](int y) { return rows[cell(x, y)]; }, [&](int y, int m) { out[cell(x, y)] = m; });
   return out;
 }
 
@@ -237,12 +243,11 @@ void PocketBuilder::stamp_surface_pass(const std::vector<Vec3>& pts) {
   refresh_tops({{lo.x, lo.y, 0}, {hi.x + 1, hi.y + 1, 1}});
 }
 
-void PocketBuilder::cut_surface_pass(const std::vector<Vec3>& pts, bool linked) {
+void PocketBuilder::cut_surface_pass(const std::vector<Vec3>& pts, const std::vector<Vec3>& link) {
   const Vec3 s = pts.front();
   std::vector<Vec3> swept;
-  if (linked) {
+  if (!link.empty()) {
     // Over the surface from where the last pass ended: the link's own drop-cutter path.
-    const std::vector<Vec3> link = surface_line({at_.x, at_.y}, {s.x, s.y});
     for (std::size_t k = 1; k < link.size(); ++k) move(MoveKind::Feed, link[k], tool_.feed, true, k == 1 ? "link" : "");
     swept = link;
   } else {
@@ -297,11 +302,14 @@ void PocketBuilder::finish_surfaces() {
         while (j < line.size() && finite(line[j])) ++j;
         if (j >= i + 2) {
           const std::vector<Vec3> pass(line.begin() + std::ptrdiff_t(i), line.begin() + std::ptrdiff_t(j));
-          const double gap = std::hypot(pass.front().x - at_.x, pass.front().y - at_.y);
-          bool linked = at_level_ && gap <= 2 * surface_step_over_ + 1e-9;
-          if (linked)
-            for (const Vec3& q : surface_line({at_.x, at_.y}, {pass.front().x, pass.front().y})) linked = linked && finite(q);
-          cut_surface_pass(pass, linked);
+          // Linked over the surface when the next pass starts within two rows and the
+          // drop-cutter path there holds everywhere.
+          std::vector<Vec3> link;
+          if (at_level_ && std::hypot(pass.front().x - at_.x, pass.front().y - at_.y) <= 2 * surface_step_over_ + 1e-9) {
+            link = surface_line({at_.x, at_.y}, {pass.front().x, pass.front().y});
+            if (!std::all_of(link.begin(), link.end(), finite)) link.clear();
+          }
+          cut_surface_pass(pass, link);
         }
         i = j;
       }

@@ -135,6 +135,14 @@ Bounds measure(const Vec3& start, const std::vector<PathMove>& original, const s
   return b;
 }
 
+// The fitted arcs stand within `tolerance` of the lines both ways, and pass inside them by
+// no more than the inward tolerance (0.0001 mm).
+void expect_faithful(const Bounds& b, double tolerance) {
+  EXPECT_LE(b.arc_to_lines, tolerance);
+  EXPECT_LE(b.lines_to_arc, tolerance);
+  EXPECT_LE(b.outside_arc, 0.0001);
+}
+
 int count(const std::vector<PathMove>& moves, MoveKind kind) {
   return int(std::count_if(moves.begin(), moves.end(), [&](const PathMove& m) { return m.kind == kind; }));
 }
@@ -158,9 +166,7 @@ TEST(ArcFit, DenseChordsOfACircleBecomeOneArcWithinTheTolerance) {
   EXPECT_EQ(stats.arcs, 1u);
   EXPECT_EQ(stats.moves_replaced, 216u);
   const Bounds b = measure(start, half, fitted);
-  EXPECT_LE(b.arc_to_lines, 0.001);
-  EXPECT_LE(b.lines_to_arc, 0.001);
-  EXPECT_LE(b.outside_arc, 0.0001);
+  expect_faithful(b, 0.001);
 }
 
 // The flanged hub's STL is a 48-gon: on its 10 mm radius each side is 0.0214 mm off the
@@ -179,9 +185,7 @@ TEST(ArcFit, A48GonIsFittedOnlyAtAToleranceAboveItsSagitta) {
   EXPECT_EQ(count(fitted, MoveKind::ArcCcw), 2) << "a full turn is two arcs (270 and 90 degrees)";
   const Bounds b = measure(start, polygon, fitted);
   EXPECT_EQ(b.arcs, 2);
-  EXPECT_LE(b.arc_to_lines, 0.025);
-  EXPECT_LE(b.lines_to_arc, 0.025);
-  EXPECT_LE(b.outside_arc, 0.0001);
+  expect_faithful(b, 0.025);
 }
 
 // A closed circle never becomes one arc (a move that ends where it starts is a full turn
@@ -198,9 +202,7 @@ TEST(ArcFit, AFullCircleIsSplitIntoTwoArcs) {
   const double mid = std::atan2(fitted[0].to.y, fitted[0].to.x);
   EXPECT_NEAR(mid, kPi / 2, 1e-9) << "270 degrees clockwise from 0 ends at 90";
   const Bounds b = measure(start, circle, fitted);
-  EXPECT_LE(b.arc_to_lines, 0.001);
-  EXPECT_LE(b.lines_to_arc, 0.001);
-  EXPECT_LE(b.outside_arc, 0.0001);
+  expect_faithful(b, 0.001);
 }
 
 // The direction is the turn's: counter-clockwise chords make G3, clockwise ones G2.
@@ -363,9 +365,7 @@ TEST(ArcFit, APathMixingLinesAndArcsKeepsTheLinesAndFitsTheArcs) {
   EXPECT_EQ(fitted[3].kind, MoveKind::ArcCcw);
   const Bounds b = measure(start, stadium, fitted);
   EXPECT_EQ(b.arcs, 2);
-  EXPECT_LE(b.arc_to_lines, 0.001);
-  EXPECT_LE(b.lines_to_arc, 0.001);
-  EXPECT_LE(b.outside_arc, 0.0001);
+  expect_faithful(b, 0.001);
 }
 
 // Chords that are not equal and not exactly on a circle (points rounded to 0.00001 mm, as
@@ -383,9 +383,7 @@ TEST(ArcFit, UnevenChordsOffTheCircleByLessThanTheToleranceFit) {
   EXPECT_LE(fitted.size(), 2u);
   const Bounds b = measure(start, moves, fitted);
   EXPECT_GE(b.arcs, 1);
-  EXPECT_LE(b.arc_to_lines, 0.001);
-  EXPECT_LE(b.lines_to_arc, 0.001);
-  EXPECT_LE(b.outside_arc, 0.0001);
+  expect_faithful(b, 0.001);
 }
 
 // The toolpath form keeps everything but the moves, and starts from Toolpath::start.
