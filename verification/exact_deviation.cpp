@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <map>
 
+#include <boost/container/small_vector.hpp>
 #include <tbb/parallel_for.h>
-#include <optional>
 
 #include "common/error.hpp"
 #include "gcode/interpreter.hpp"
@@ -36,7 +36,9 @@ struct Run {
   double lo = 0, hi = 0;
   int lo_op = 0, hi_op = 0;
 };
-using Runs = std::vector<Run>;
+// Inline: nearly every vector holds one or two runs, and a sweep that reaches a vector
+// then finds them where it finds the vector's other state, without a second fetch.
+using Runs = boost::container::small_vector<Run, 2>;
 
 void subtract(Runs& runs, Span s, int op, Runs& scratch) {
   scratch.clear();
@@ -151,16 +153,16 @@ class Verifier {
   void sweep() {
     tbb::parallel_for(0, kParts, [&](int part) {
       Runs scratch;
-      const auto& samples = surface_.samples();
       for (const Step& step : steps_) {
         const FrameIndex& index = surface_.frame(step.approach, std::size_t(part), kParts);
         const bool cuts = step.instrument->head < 0;
         for (const sim::ConvexPiece& piece : step.instrument->pieces)
-          index.for_each_near(swept_box(piece, step.segment, ceiling_), [&](std::uint32_t i) {
-            Runs& runs = runs_[i];
+          index.for_each_near(swept_box(piece, step.segment, ceiling_), [&](const FrameVector& v) {
+            Runs& runs = runs_[v.id];
             if (cuts && runs.empty()) return;  // nothing to cut
-            const SurfaceSample& s = samples[i];
-            const Span span = line_in_sweep(piece, step.segment, index.point(i), index.normal(i), -s.inward, s.outward);
+            // A cut is asked only about the stretch that still holds material.
+            const Span span = cuts ? line_in_sweep(piece, step.segment, v.point, v.normal, runs.front().lo, runs.back().hi)
+                                   : line_in_sweep(piece, step.segment, v.point, v.normal, v.t0, v.t1);
             if (span.empty()) return;
             if (cuts) subtract(runs, span, step.op, scratch);
             else unite(runs, span, step.op, scratch);

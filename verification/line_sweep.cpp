@@ -69,10 +69,39 @@ Span capsule(const V3& p, const V3& d, const V3& e0, const V3& e1, double r) {
   return hull(s, meet(tube, slab(w.dot(u), d.dot(u), 0, length)));
 }
 
-// A capsule in XY (z ignored) against the line's XY projection.
+// The length of (x, y): std::hypot guards against overflow, which lengths in
+// mm never come near, at several times the cost, in the innermost loops of a sweep.
+double norm(double x, double y) { return std::sqrt(x * x + y * y); }
+
+// t with (p + t d - c) in the disc of radius r about c, in XY.
+Span disc_xy(double px, double py, double dx, double dy, double cx, double cy, double r) {
+  const double wx = px - cx, wy = py - cy;
+  return quadratic_at_most_zero(dx * dx + dy * dy, 2 * (dx * wx + dy * wy), wx * wx + wy * wy - r * r);
+}
+
+// A capsule in XY (z ignored) against the line's XY projection, in plain 2D: the two end
+// discs and the rectangle between them (two slabs across and along the segment). This is
+// the sweep of every level or plunging cylinder, the most frequent question by far.
 Span capsule_xy(const V3& p, const V3& d, const V3& a, const V3& b, double r) {
-  const V3 p2(p.x(), p.y(), 0), d2(d.x(), d.y(), 0), a2(a.x(), a.y(), 0), b2(b.x(), b.y(), 0);
-  return capsule(p2, d2, a2, b2, r);
+  const double dx = d.x(), dy = d.y();
+  if (dx * dx + dy * dy <= kTiny) {
+    // The line stands still in XY: inside everywhere or nowhere.
+    const double ux = b.x() - a.x(), uy = b.y() - a.y(), wx = p.x() - a.x(), wy = p.y() - a.y();
+    const double uu = ux * ux + uy * uy;
+    const double s = uu > kTiny ? std::clamp((wx * ux + wy * uy) / uu, 0.0, 1.0) : 0.0;
+    const double ex = wx - s * ux, ey = wy - s * uy;
+    return ex * ex + ey * ey <= r * r ? all() : none();
+  }
+  Span s = disc_xy(p.x(), p.y(), dx, dy, a.x(), a.y(), r);
+  const double ux = b.x() - a.x(), uy = b.y() - a.y();
+  const double length = norm(ux, uy);
+  if (length <= kTiny) return s;
+  s = hull(s, disc_xy(p.x(), p.y(), dx, dy, b.x(), b.y(), r));
+  const double cx = ux / length, cy = uy / length;  // along the segment; (-cy, cx) across it
+  const double wx = p.x() - a.x(), wy = p.y() - a.y();
+  const Span rectangle = meet(slab(wx * cx + wy * cy, dx * cx + dy * cy, 0, length),
+                              slab(-wx * cy + wy * cx, -dx * cy + dy * cx, -r, r));
+  return hull(s, rectangle);
 }
 
 // Distance in XY from q to the segment a-b.
@@ -81,21 +110,21 @@ double distance_xy(const V3& q, const V3& a, const V3& b) {
   const double wx = q.x() - a.x(), wy = q.y() - a.y();
   const double uu = ux * ux + uy * uy;
   const double s = uu > kTiny ? std::clamp((wx * ux + wy * uy) / uu, 0.0, 1.0) : 0.0;
-  return std::hypot(wx - s * ux, wy - s * uy);
+  return norm(wx - s * ux, wy - s * uy);
 }
 
 // The piece's convex gauge at v (relative to its programmed point): <= 0 inside.
 double gauge(const sim::ConvexPiece& piece, const V3& v) {
   const double slab_term = std::max(piece.from - v.z(), v.z() - piece.to);
-  const double radial = std::hypot(v.x(), v.y());
+  const double radial = norm(v.x(), v.y());
   double shape = 0;
   switch (piece.kind) {
     case Kind::Cylinder: shape = radial - piece.radius; break;
-    case Kind::Sphere: shape = std::hypot(radial, v.z() - piece.centre) - piece.radius; break;
+    case Kind::Sphere: shape = norm(radial, v.z() - piece.centre) - piece.radius; break;
     case Kind::Ellipsoid:
-      shape = std::hypot(radial, (v.z() - piece.centre) * piece.radius / piece.half_height) - piece.radius;
+      shape = norm(radial, (v.z() - piece.centre) * piece.radius / piece.half_height) - piece.radius;
       break;
-    case Kind::Torus: shape = std::hypot(std::max(0.0, radial - piece.ring), v.z() - piece.centre) - piece.radius; break;
+    case Kind::Torus: shape = norm(std::max(0.0, radial - piece.ring), v.z() - piece.centre) - piece.radius; break;
   }
   return std::max(shape, slab_term);
 }
@@ -144,6 +173,20 @@ Span sublevel(G g, double t0, double t1) {
   return {edge(t0, tm), edge(t1, tm)};
 }
 
+// Whether the stretch [t0, t1] of the line surely misses the sweep: it lies above or below
+// every height the piece reaches, or its middle is farther in XY from the segment than the
+// piece's reach and the stretch's own half length together. Most stretches a sweep asks
+// about are settled by this, without the exact geometry below.
+bool surely_misses(const sim::ConvexPiece& piece, const V3& p, const V3& d, double t0, double t1, const V3& a,
+                   const V3& b) {
+  const double za = p.z() + t0 * d.z(), zb = p.z() + t1 * d.z();
+  if (std::max(za, zb) < std::min(a.z(), b.z()) + piece.from || std::min(za, zb) > std::max(a.z(), b.z()) + piece.to)
+    return true;
+  const V3 m = p + 0.5 * (t0 + t1) * d;
+  const double half = 0.5 * (t1 - t0) * norm(d.x(), d.y());
+  return distance_xy(m, a, b) > piece.reach() + half;
+}
+
 bool whole_in_slab(const sim::ConvexPiece& piece, double half_height) {
   return piece.from <= piece.centre - half_height + 1e-12 && piece.to >= piece.centre + half_height - 1e-12;
 }
@@ -158,15 +201,19 @@ Span line_in_sweep(const sim::ConvexPiece& piece, const sim::Segment& segment, c
   // rounding in the last digits).
   const bool level = std::abs(move.z()) <= 1e-9;
   const bool vertical = std::abs(move.x()) <= 1e-9 && std::abs(move.y()) <= 1e-9;
+  if (!(t0 <= t1) || surely_misses(piece, p, d, t0, t1, a, b)) return none();
   Span range{t0, t1};
   switch (piece.kind) {
     case Kind::Cylinder:
-      if (level)
-        return meet(range, meet(slab(p.z(), d.z(), a.z() + piece.from, a.z() + piece.to),
-                                capsule_xy(p, d, a, b, piece.radius)));
-      if (vertical)
-        return meet(range, meet(slab(p.z(), d.z(), std::min(a.z(), b.z()) + piece.from, std::max(a.z(), b.z()) + piece.to),
-                                capsule_xy(p, d, a, a, piece.radius)));
+      // The slab first: most lines a sweep is asked about pass above or below it.
+      if (level) {
+        range = meet(range, slab(p.z(), d.z(), a.z() + piece.from, a.z() + piece.to));
+        return range.empty() ? none() : meet(range, capsule_xy(p, d, a, b, piece.radius));
+      }
+      if (vertical) {
+        range = meet(range, slab(p.z(), d.z(), std::min(a.z(), b.z()) + piece.from, std::max(a.z(), b.z()) + piece.to));
+        return range.empty() ? none() : meet(range, capsule_xy(p, d, a, a, piece.radius));
+      }
       break;
     case Kind::Sphere:
       if (whole_in_slab(piece, piece.radius)) {
@@ -195,7 +242,7 @@ Span line_in_sweep(const sim::ConvexPiece& piece, const sim::Segment& segment, c
         return sublevel(
             [&](double t) {
               const V3 q = p + t * d;
-              return std::hypot(std::max(0.0, distance_xy(q, a2, b2) - piece.ring), q.z() - zc) - piece.radius;
+              return norm(std::max(0.0, distance_xy(q, a2, b2) - piece.ring), q.z() - zc) - piece.radius;
             },
             t0, t1);
       }
@@ -209,7 +256,7 @@ Span line_in_sweep(const sim::ConvexPiece& piece, const sim::Segment& segment, c
             [&](double t) {
               const V3 q = p + t * d;
               const double dz = q.z() < z0 ? z0 - q.z() : q.z() > z1 ? q.z() - z1 : 0.0;
-              return std::hypot(std::max(0.0, std::hypot(q.x() - a.x(), q.y() - a.y()) - piece.ring), dz) - piece.radius;
+              return norm(std::max(0.0, norm(q.x() - a.x(), q.y() - a.y()) - piece.ring), dz) - piece.radius;
             },
             t0, t1);
       }

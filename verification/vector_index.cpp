@@ -15,14 +15,15 @@ Vec3 along(const SurfaceSample& s, double t) {
 
 FrameIndex::FrameIndex(const std::vector<SurfaceSample>& samples, config::Approach approach, std::size_t part,
                        std::size_t parts) {
-  points_.reserve(samples.size());
-  normals_.reserve(samples.size());
+  std::vector<Vec3> points, normals;
+  points.reserve(samples.size());
+  normals.reserve(samples.size());
   std::vector<geometry::Box3> boxes;
   boxes.reserve(samples.size());
   geometry::Box3 box{{1e300, 1e300, 1e300}, {-1e300, -1e300, -1e300}};
   for (const SurfaceSample& s : samples) {
-    points_.push_back(toolpaths::part_to_work(s.point, approach));
-    normals_.push_back(toolpaths::part_to_work(s.normal, approach));
+    points.push_back(toolpaths::part_to_work(s.point, approach));
+    normals.push_back(toolpaths::part_to_work(s.normal, approach));
     const Vec3 a = toolpaths::part_to_work(along(s, -s.inward), approach);
     const Vec3 b = toolpaths::part_to_work(along(s, s.outward), approach);
     const geometry::Box3 v{{std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)},
@@ -53,8 +54,11 @@ FrameIndex::FrameIndex(const std::vector<SurfaceSample>& samples, config::Approa
   start_ = count;
   entries_.resize(count.back());
   for (std::uint32_t i = 0; i < boxes.size(); ++i)
-    if (mine(i)) each_column(boxes[i], [&](std::size_t c) { entries_[count[c]++] = {boxes[i].min.z, boxes[i].max.z, boxes[i].min.x, boxes[i].max.x,
-                                                                  boxes[i].min.y, boxes[i].max.y, i}; });
+    if (mine(i))
+      each_column(boxes[i], [&](std::size_t c) {
+        entries_[count[c]++] = {boxes[i].min.z, boxes[i].max.z, points[i], normals[i], -samples[i].inward,
+                                samples[i].outward, i};
+      });
   for (std::size_t c = 0; c < columns; ++c)
     std::sort(entries_.begin() + start_[c], entries_.begin() + start_[c + 1],
               [](const Entry& a, const Entry& b) { return a.z0 < b.z0; });

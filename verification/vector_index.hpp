@@ -19,14 +19,22 @@
 
 namespace hybridctl::verification {
 
+// One sample's vector in a work frame: the points point + t normal, t in [t0, t1].
+// Everything a sweep reads of a vector lies in its entry, next to its neighbours in the
+// column: a sweep's time goes to fetching vectors from memory, not to the geometry.
+struct FrameVector {
+  double z0, z1;  // the vector's lowest and highest Z
+  geometry::Vec3 point, normal;
+  double t0, t1;
+  std::uint32_t id;  // the sample's index in DesignSurface::samples()
+};
+
 class FrameIndex {
  public:
   FrameIndex(const std::vector<SurfaceSample>& samples, config::Approach approach, std::size_t part = 0,
              std::size_t parts = 1);
-  const geometry::Vec3& point(std::size_t i) const { return points_[i]; }
-  const geometry::Vec3& normal(std::size_t i) const { return normals_[i]; }
 
-  // Calls fn(i) once for every vector whose box meets `box`.
+  // Calls fn(vector) once for every vector whose box meets `box`.
   template <class F>
   void for_each_near(const geometry::Box3& box, F&& fn) const {
     const auto [x0, x1] = range(box.min.x - wide_, box.max.x + wide_, 0);
@@ -35,21 +43,22 @@ class FrameIndex {
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) {
         const std::size_t c = column(x, y);
-        const Entry* e = entries_.data() + start_[c];
-        const Entry* last = entries_.data() + start_[c + 1];
+        const FrameVector* e = entries_.data() + start_[c];
+        const FrameVector* last = entries_.data() + start_[c + 1];
         e = lower_bound(e, last, from);
-        for (; e != last && e->z0 <= box.max.z; ++e)
-          if (e->z1 >= box.min.z && e->x1 >= box.min.x && e->x0 <= box.max.x && e->y1 >= box.min.y &&
-              e->y0 <= box.max.y)
-            fn(e->id);
+        for (; e != last && e->z0 <= box.max.z; ++e) {
+          if (e->z1 < box.min.z) continue;
+          const double xa = e->point.x + e->t0 * e->normal.x, xb = e->point.x + e->t1 * e->normal.x;
+          if (std::max(xa, xb) < box.min.x || std::min(xa, xb) > box.max.x) continue;
+          const double ya = e->point.y + e->t0 * e->normal.y, yb = e->point.y + e->t1 * e->normal.y;
+          if (std::max(ya, yb) < box.min.y || std::min(ya, yb) > box.max.y) continue;
+          fn(*e);
+        }
       }
   }
 
  private:
-  struct Entry {
-    double z0, z1, x0, x1, y0, y1;  // the vector's box
-    std::uint32_t id;
-  };
+  using Entry = FrameVector;
   static const Entry* lower_bound(const Entry* first, const Entry* last, double z);
   std::pair<int, int> range(double a, double b, int axis) const {
     const double lo = axis == 0 ? lo_.x : lo_.y;
@@ -59,7 +68,6 @@ class FrameIndex {
   }
   std::size_t column(int x, int y) const { return std::size_t(y) * std::size_t(n_[0]) + std::size_t(x); }
 
-  std::vector<geometry::Vec3> points_, normals_;
   geometry::Vec3 lo_;
   double cell_ = 1, tallest_ = 0, wide_ = 0;
   int n_[2] = {1, 1};

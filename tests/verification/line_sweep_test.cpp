@@ -80,6 +80,13 @@ TEST(LineInSweep, AFlatCutterMovedLevelSweepsACapsuleInXyOverItsFlute) {
   const Span s = line_in_sweep(cylinder(1.5, 0, 4), {{0, 0, 1}, {5, 0, 1}}, {2, 0, -10}, {0, 0, 1}, -100, 100);
   EXPECT_NEAR(s.lo, 11, 1e-12);
   EXPECT_NEAR(s.hi, 15, 1e-12);
+  // Straight down just beside the capsule, over its side and over an end: no contact.
+  EXPECT_TRUE(line_in_sweep(cylinder(1.5, 0, 4), {{0, 0, 1}, {5, 0, 1}}, {2, 1.51, -10}, {0, 0, 1}, -100, 100).empty());
+  EXPECT_TRUE(line_in_sweep(cylinder(1.5, 0, 4), {{0, 0, 1}, {5, 0, 1}}, {6.07, 1.07, -10}, {0, 0, 1}, -100, 100).empty());
+  // Along the segment's own line, at the flute's height: from one end disc's far side to the other's.
+  const Span along = line_in_sweep(cylinder(1.5, 0, 4), {{0, 0, 1}, {5, 0, 1}}, {-10, 0, 2}, {1, 0, 0}, -100, 100);
+  EXPECT_NEAR(along.lo, 8.5, 1e-12);
+  EXPECT_NEAR(along.hi, 16.5, 1e-12);
 }
 
 TEST(LineInSweep, APlungeSweepsTheCylinderFromTheLowestTipToTheHighestTop) {
