@@ -10,6 +10,7 @@
 # Requests: {"op": "status"} | {"op": "prepare", "feed_override": F} |
 #           {"op": "run", "file": PATH} | {"op": "pause"} | {"op": "resume"} |
 #           {"op": "abort"} | {"op": "estop"}
+# Each request may carry "id": N, which its reply carries back.
 # Replies:  {"ok": true, ...} or {"ok": false, "error": TEXT}; every status reply says
 #           whether LinuxCNC answers ("connected") and carries the error channel's
 #           messages that arrived since the last reply.
@@ -23,14 +24,78 @@ import linuxcnc
 TIMEOUT_S = 5.0
 
 
+def task_name(ini):
+    """The task program the INI names ([TASK] TASK, milltask by default), as the kernel
+    shows a process's name (its first 15 characters)."""
+    name, section = "milltask", None
+    try:
+        with open(ini) as f:
+            for line in f:
+                line = line.split("#", 1)[0].strip()
+                if line.startswith("["):
+                    section = line.strip("[]").strip()
+                elif section == "TASK" and "=" in line:
+                    key, value = (x.strip() for x in line.split("=", 1))
+                    if key == "TASK" and value:
+                        name = os.path.basename(value)
+    except OSError:
+        pass
+    return name[:15]
+
+
+def process_start(pid):
+    """The start time of process pid (clock ticks since boot), or None when it is gone."""
+    try:
+        with open("/proc/%d/stat" % pid) as f:
+            return int(f.read().rsplit(")", 1)[1].split()[19])
+    except (OSError, IndexError, ValueError):
+        return None
+
+
+def find_task(name):
+    """(pid, start time) of the running process called name, or None."""
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open("/proc/%s/comm" % entry) as f:
+                if f.read().strip() != name:
+                    continue
+        except OSError:
+            continue
+        start = process_start(int(entry))
+        if start is not None:
+            return int(entry), start
+    return None
+
+
 class Link:
+    """The channels to one run of LinuxCNC, and that run's task process.
+
+    A status channel outlives the LinuxCNC it was opened on: its shared memory stays
+    attached after LinuxCNC has gone, and polls go on reading the last status it wrote. So
+    the link also follows LinuxCNC's task process (found by name, checked by pid and start
+    time): when it ends, the channels are dropped and LinuxCNC counts as not answering;
+    a LinuxCNC started again is a new run, opened afresh."""
+
     def __init__(self):
         self.stat = self.command = self.errors = None
+        self.task = None  # (name, pid, start) of the run the channels belong to
         self.pending = []  # messages read while waiting, for the next status
 
     def connect(self):
+        if self.stat is not None and process_start(self.task[1]) != self.task[2]:
+            gone = self.task
+            self.drop()
+            raise RuntimeError("LinuxCNC's task process (%s, pid %d) ended" % (gone[0], gone[1]))
         if self.stat is None:
-            self.stat = linuxcnc.stat()
+            stat = linuxcnc.stat()
+            stat.poll()
+            name = task_name(stat.ini_filename)
+            found = find_task(name)
+            if found is None:
+                raise RuntimeError("LinuxCNC's task process (%s) is not running" % name)
+            self.stat, self.task = stat, (name,) + found
             self.command = linuxcnc.command()
             self.errors = linuxcnc.error_channel()
         self.stat.poll()
@@ -38,6 +103,7 @@ class Link:
 
     def drop(self):
         self.stat = self.command = self.errors = None
+        self.task = None
 
     def drain_errors(self):
         out, self.pending = self.pending, []
@@ -69,7 +135,7 @@ class Link:
 def status(link):
     try:
         s = link.connect()
-    except Exception as e:  # linuxcnc.error, or SystemError from a half-started LinuxCNC
+    except Exception as e:  # linuxcnc.error, SystemError from a half-started LinuxCNC, or its task gone
         link.drop()
         return {"ok": True, "connected": False, "why": str(e)}
     sp = s.spindle[0] if s.spindle else {"speed": 0.0, "direction": 0}
@@ -197,13 +263,19 @@ def main():
     os.dup2(2, 1)
     link = Link()
     for line in sys.stdin:
+        request = {}
         try:
-            reply = handle(link, json.loads(line))
+            request = json.loads(line)
+            reply = handle(link, request)
         except linuxcnc.error as e:
             link.drop()
             reply = {"ok": False, "error": "LinuxCNC: " + str(e)}
         except Exception as e:  # a reply for every request, whatever went wrong
             reply = {"ok": False, "error": type(e).__name__ + ": " + str(e)}
+        # The request's number back: a reply the bridge stopped waiting for is told apart
+        # from the one to its next request.
+        if isinstance(request, dict) and "id" in request:
+            reply["id"] = request["id"]
         replies.write(json.dumps(reply) + "\n")
         replies.flush()
 

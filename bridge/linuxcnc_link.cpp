@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <csignal>
+#include <cstdint>
 #include <cstring>
 
 #include <fcntl.h>
@@ -34,6 +35,14 @@ json parse_reply(const std::string& reply) {
   json j = json::parse(reply, nullptr, false);
   if (j.is_discarded() || !j.is_object()) throw LinkError("LinuxCNC agent: not a JSON object: " + reply.substr(0, 200));
   return j;
+}
+
+// The request number a reply carries back; 0 when it carries none.
+std::uint64_t reply_id(const std::string& reply) {
+  const json j = json::parse(reply, nullptr, false);
+  if (!j.is_object()) return 0;
+  const auto it = j.find("id");
+  return it != j.end() && it->is_number_unsigned() ? it->get<std::uint64_t>() : 0;
 }
 
 }  // namespace
@@ -110,7 +119,10 @@ LinuxcncLink::~LinuxcncLink() {
 }
 
 std::string LinuxcncLink::request(const std::string& json_line) {
-  const std::string line = json_line + "\n";
+  // Numbered: a reply that comes after its request timed out is read and dropped here,
+  // not taken for the answer to the next request.
+  const std::uint64_t id = ++last_id_;
+  const std::string line = json_line.substr(0, json_line.rfind('}')) + ",\"id\":" + std::to_string(id) + "}\n";
   for (std::size_t sent = 0; sent < line.size();) {
     const ssize_t n = write(to_child_, line.data() + sent, line.size() - sent);
     if (n < 0 && errno == EINTR) continue;
@@ -123,7 +135,8 @@ std::string LinuxcncLink::request(const std::string& json_line) {
     if (end != std::string::npos) {
       std::string reply = buffered_.substr(0, end);
       buffered_.erase(0, end + 1);
-      return reply;
+      if (reply_id(reply) == id) return reply;
+      continue;  // the late reply to an earlier request
     }
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
     if (left.count() <= 0) throw LinkError("the LinuxCNC agent did not answer " + json_line + " within " +

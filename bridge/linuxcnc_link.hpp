@@ -13,6 +13,7 @@
 #include <array>
 #include <chrono>
 #include <stdexcept>
+#include <cstdint>
 #include <string>
 #include <sys/types.h>
 #include <vector>
@@ -98,6 +99,7 @@ class LinuxcncLink {
   int to_child_ = -1;
   int from_child_ = -1;
   std::string buffered_;
+  std::uint64_t last_id_ = 0;  // the number of the last request sent
 };
 
 }  // namespace hybridctl::bridge
