@@ -16,7 +16,7 @@ enum ExitCode : int {
   kBadInput = 3,
   kNotManufacturable = 4,
   kMachineStopped = 5,  // run: the machine stopped (alarm, abort, operator) before the program's end
-  kUnreachable = 6,     // run, status: the controller could not be reached
+  kUnreachable = 6,     // run, status: the controller could not be reached; cell: the database
 };
 
 using Runner = std::function<int()>;
@@ -34,5 +34,6 @@ void add_run_command(CLI::App& app, Runner& runner);
 void add_dry_run_command(CLI::App& app, Runner& runner);
 void add_bridge_command(CLI::App& app, Runner& runner);
 void add_report_command(CLI::App& app, Runner& runner);
+void add_cell_command(CLI::App& app, Runner& runner);
 
 }  // namespace hybridctl::cli

@@ -16,7 +16,7 @@ int main(int argc, char** argv) {
       "from a part (STL) and a machine description (YAML).\n\n"
       "Exit codes: 0 success, 1 internal error, 2 usage error, 3 bad input (file, YAML, STL, G-code),\n"
       "4 part not manufacturable with the machine's primitives (plan), 5 the machine stopped before\n"
-      "the program's end (run), 6 the controller could not be reached (run, status).",
+      "the program's end (run), 6 the controller could not be reached (run, status), or the cell's database (cell).",
       "hybridctl"};
   app.set_version_flag("--version", "hybridctl 0.1.0");
   app.require_subcommand(1);
@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
   add_dry_run_command(app, runner);
   add_bridge_command(app, runner);
   add_report_command(app, runner);
+  add_cell_command(app, runner);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
