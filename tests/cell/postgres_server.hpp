@@ -2,8 +2,8 @@
 // A PostgreSQL server of the test's own (Debian's postgresql, as scripts/setup installs it):
 // initdb in a temporary directory, then `postgres` on 127.0.0.1 at a free port, as a
 // separate process, stopped (and its directory removed) when the object goes. PostgreSQL
-// refuses to run as root: as root, both run as the unprivileged user scripts/setup creates
-// (hybridctl-cnc). Missing binaries or a server that does not start fail loudly.
+// refuses to run as root: as root, both run as the `postgres` user Debian's package creates
+// (not as hybridctl-cnc, whose processes the LinuxCNC tests take for another LinuxCNC). Missing binaries or a server that does not start fail loudly.
 
 #include <netinet/in.h>
 #include <grp.h>
@@ -34,7 +34,9 @@ class PostgresServer {
     dir_ = pattern;
     if (geteuid() == 0) {
       const passwd* pw = getpwnam(kUser);
-      if (!pw) throw std::runtime_error(std::string("no user ") + kUser + ": run scripts/setup (PostgreSQL will not run as root)");
+      if (!pw)
+        throw std::runtime_error(std::string("no user ") + kUser + ": run scripts/setup (it installs postgresql, which makes it; "
+                                 "PostgreSQL will not run as root)");
       user_ = kUser;
       std::filesystem::permissions(dir_, std::filesystem::perms::owner_all);
       if (chown(dir_.c_str(), pw->pw_uid, pw->pw_gid) != 0) throw std::runtime_error("cannot give the server's directory to " + user_);
@@ -83,7 +85,7 @@ class PostgresServer {
   }
 
  private:
-  static constexpr const char* kUser = "hybridctl-cnc";
+  static constexpr const char* kUser = "postgres";
 
   static std::string find_bin() {
     for (int v = 20; v >= 12; --v) {
