@@ -72,5 +72,13 @@ PY
   milling=$(grep -c '^(action [0-9]*:.*subtractive' "$program" || true)
   tools=$(grep -Ec '(^|[^0-9A-Z])M0?6([^0-9]|$)' "$program" || true)
   stops=$(grep -Ec '(^|[^0-9A-Z])M0?[01]([^0-9]|$)' "$program" || true)
-  echo "$name: the job: plan $rank, $lines lines: $actions actions ($additive deposition, $milling milling), $tools tool changes, $stops program stops"
+  # What finishing passes bring (issue 42: a program with arcs and many short moves): arcs,
+  # and feed moves under 0.5 mm (from the previous programmed X and Y).
+  local arcs short
+  arcs=$(grep -Ec '(^|[^0-9A-Z.])G0?[23]([^0-9]|$)' "$program" || true)
+  short=$(awk '{ x = px; y = py; for (i = 1; i <= NF; ++i) { if ($i ~ /^X-?[0-9.]+$/) x = substr($i, 2) + 0;
+                 if ($i ~ /^Y-?[0-9.]+$/) y = substr($i, 2) + 0 }
+                 if ($1 == "G1" && (x - px) ^ 2 + (y - py) ^ 2 < 0.25 && (x != px || y != py)) ++n; px = x; py = y }
+               END { print n + 0 }' "$program")
+  echo "$name: the job: plan $rank, $lines lines: $actions actions ($additive deposition, $milling milling), $tools tool changes, $stops program stops, $arcs arcs, $short feed moves under 0.5 mm"
 }
