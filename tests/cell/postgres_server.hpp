@@ -112,6 +112,8 @@ class PostgresServer {
     if (pid < 0) throw std::runtime_error("cannot fork");
     if (pid == 0) {
       if (pw && (setgroups(0, nullptr) != 0 || setgid(pw->pw_gid) != 0 || setuid(pw->pw_uid) != 0)) _exit(126);
+      // Its own directory as the working one: the user may not enter the test's (a clone under /root).
+      if (chdir(dir_.c_str()) != 0) _exit(126);
       FILE* out = std::fopen(log.c_str(), "w");
       if (out) dup2(fileno(out), 1), dup2(fileno(out), 2);
       std::vector<char*> argv;
