@@ -54,6 +54,8 @@ CREATE TABLE cell_job_events (
   detail  text
 );
 CREATE INDEX cell_job_events_job ON cell_job_events (job);
+-- The jobs' parts and plans are the shop's: the cell's role (the owner) alone reads them.
+REVOKE ALL ON cell_schema, cell_machines, cell_jobs, cell_job_files, cell_job_events FROM PUBLIC;
 )sql"},
   };
   return all;

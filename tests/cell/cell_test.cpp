@@ -156,6 +156,16 @@ TEST_F(Cell, InitMakesTheSchemaOnceWhetherRunTwiceOrThreeAtOnce) {
   EXPECT_NE(again.out.find("schema version 1, up to date"), std::string::npos) << again.out;
   EXPECT_EQ(value("SELECT count(*) FROM cell_schema"), "1");
   EXPECT_EQ(value("SELECT count(*) FROM pg_tables WHERE tablename LIKE 'cell_%'"), "5");
+  // Another role of the same server reads none of the jobs' files.
+  Database db(server_->uri());
+  db.exec("a role", "CREATE ROLE another_shop");
+  db.exec("that role", "SET ROLE another_shop");
+  try {
+    db.exec("its read", "SELECT count(*) FROM cell_job_files");
+    ADD_FAILURE() << "another role read the jobs' files";
+  } catch (const DatabaseError& e) {
+    EXPECT_EQ(e.sqlstate(), "42501") << e.what();  // insufficient_privilege
+  }
 }
 
 TEST_F(Cell, TwoHundredJobsOverFourWorkersArePlannedEachExactlyOnce) {
