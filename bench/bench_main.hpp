@@ -19,6 +19,7 @@
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -26,6 +27,14 @@
 #include <vector>
 
 namespace hybridctl::bench {
+
+/// Wall seconds that fn() takes, for benchmarks that time two ways in one run.
+template <class Fn>
+double seconds_of(Fn&& fn) {
+  const auto t0 = std::chrono::steady_clock::now();
+  fn();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
 /// A benchmark function and its name, for lists of smoke cases.
 using NamedCase = std::pair<const char*, void (*)(benchmark::State&)>;

@@ -27,12 +27,6 @@ using namespace hybridctl;
 
 int g_top_k = 0;  // plans per part: 0 as `plan` (its default); 1 for --smoke
 
-double seconds_of(auto&& fn) {
-  const auto t0 = std::chrono::steady_clock::now();
-  fn();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 void exact_against_voxels(benchmark::State& state, const std::string& part, const std::string& machine_file,
                           double tolerance = 0) {
   const std::string root = HYBRIDCTL_SOURCE_DIR "/";
@@ -52,10 +46,10 @@ void exact_against_voxels(benchmark::State& state, const std::string& part, cons
     for (const plan::PlanFilePlan& p : file.plans) {
       validation::ExecutionOptions alone;
       alone.verify_exactly = false;
-      voxels += seconds_of([&] { benchmark::DoNotOptimize(validation::execute_plan(file, p, machine, alone)); });
+      voxels += bench::seconds_of([&] { benchmark::DoNotOptimize(validation::execute_plan(file, p, machine, alone)); });
       validation::ExecutionOptions with;
       with.surfaces = std::make_shared<verification::DesignSurfaces>(mesh, part);
-      exact += seconds_of([&] { benchmark::DoNotOptimize(validation::execute_plan(file, p, machine, with)); });
+      exact += bench::seconds_of([&] { benchmark::DoNotOptimize(validation::execute_plan(file, p, machine, with)); });
     }
   }
   const double plans = double(file.plans.size()) * double(state.iterations());

@@ -30,12 +30,6 @@ using namespace hybridctl;
 int g_top_k = 0;         // plans per part: 0 as `plan` (its default); 1 for --smoke
 double g_voxel = 0.5;    // 1 for --smoke
 
-double seconds_of(auto&& fn) {
-  const auto t0 = std::chrono::steady_clock::now();
-  fn();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 // Minutes of the plan's programs under `gcode check`'s time model.
 double cycle_minutes(const toolpaths::PlanExport& made, const config::Machine& machine) {
   double minutes = 0;
@@ -52,7 +46,7 @@ void finishing(benchmark::State& state, const std::string& part, const std::stri
   options.voxel_size = g_voxel;
   if (g_top_k > 0) options.top_k = g_top_k;
   planner::PlanningResult planned;
-  const double planning = seconds_of([&] { planned = planner::plan_part(mesh, part, machine, options); });
+  const double planning = bench::seconds_of([&] { planned = planner::plan_part(mesh, part, machine, options); });
   const plan::PlanFile file = planner::to_plan_file(planned, {part, machine_file, machine.name, ""}, ".");
   if (file.plans.empty()) {
     state.SkipWithError((part + " has no plan on " + machine_file).c_str());
@@ -64,8 +58,8 @@ void finishing(benchmark::State& state, const std::string& part, const std::stri
   for (auto _ : state) {
     for (const plan::PlanFilePlan& p : file.plans) {
       toolpaths::PlanExport a, b;
-      rough_s += seconds_of([&] { a = toolpaths::export_plan(file, p, machine, rough); });
-      finished_s += seconds_of([&] { b = toolpaths::export_plan(file, p, machine, finished); });
+      rough_s += bench::seconds_of([&] { a = toolpaths::export_plan(file, p, machine, rough); });
+      finished_s += bench::seconds_of([&] { b = toolpaths::export_plan(file, p, machine, finished); });
       added_minutes += cycle_minutes(b, machine) - cycle_minutes(a, machine);
     }
   }

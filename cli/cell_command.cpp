@@ -8,7 +8,6 @@
 #include <fstream>
 #include <memory>
 #include <regex>
-#include <sstream>
 #include <thread>
 #include <unistd.h>
 
@@ -19,6 +18,7 @@
 #include "cli/ranges.hpp"
 #include "common/error.hpp"
 #include "config/machine_loader.hpp"
+#include "gcode/files.hpp"
 #include "plan/plan_machine.hpp"
 
 namespace hybridctl::cli {
@@ -48,14 +48,6 @@ int guarded(const std::function<int()>& fn) {
     std::fprintf(stderr, "hybridctl: %s\n", e.what());
     return e.connection_lost() ? kUnreachable : kInternalError;
   }
-}
-
-std::string read_file(const std::string& path, const char* what) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot read the " + what);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 int cell_init(const CellArgs& a) {
@@ -92,7 +84,7 @@ int submit(const CellArgs& a) {
   cell::Submission s;
   s.machine = a.machine;
   s.part_name = fs::path(a.part).filename().string();
-  s.part_stl = read_file(a.part, "part (STL)");
+  s.part_stl = gcode::read_text_file(a.part);
   if (s.part_stl.size() < 84) throw InputError(a.part + ": " + std::to_string(s.part_stl.size()) + " bytes: not an STL (at least 84 expected)");
   if (a.voxel > 0) s.request.voxel = a.voxel;
   if (a.tolerance >= 0) s.request.tolerance = a.tolerance;

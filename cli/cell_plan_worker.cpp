@@ -21,6 +21,7 @@
 #include "cell/jobs.hpp"
 #include "cell/schema.hpp"
 #include "cli/commands.hpp"
+#include "gcode/files.hpp"
 
 namespace hybridctl::cli {
 namespace {
@@ -87,13 +88,6 @@ std::string safe_file_name(const std::string& name, const std::string& fallback)
   return out;
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // The child: this hybridctl's `plan`, its output into the job's log; it dies with the worker.
 pid_t start_planning(const fs::path& dir, const cell::Claim& job, const fs::path& part, const fs::path& machine) {
   std::vector<std::string> args = {"/proc/self/exe", "plan", part.string(), "--machine", machine.string(),
@@ -128,8 +122,8 @@ std::vector<std::pair<std::string, std::string>> plan_files(const fs::path& dir)
   std::error_code ec;
   if (fs::is_directory(dir / "plan", ec))
     for (const fs::directory_entry& e : fs::recursive_directory_iterator(dir / "plan"))
-      if (e.is_regular_file()) files.emplace_back(fs::relative(e.path(), dir / "plan").string(), slurp(e.path()));
-  files.emplace_back("plan.log", slurp(dir / "plan.log"));
+      if (e.is_regular_file()) files.emplace_back(fs::relative(e.path(), dir / "plan").string(), gcode::read_text_file(e.path()));
+  files.emplace_back("plan.log", fs::exists(dir / "plan.log", ec) ? gcode::read_text_file(dir / "plan.log") : std::string());
   return files;
 }
 
