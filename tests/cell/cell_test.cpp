@@ -17,7 +17,9 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <sstream>
 #include <thread>
+#include <vector>
 
 #include "../cli/shell.hpp"
 #include "cell/database.hpp"
@@ -53,15 +55,31 @@ void write_box(const fs::path& path, float sx, float sy, float sz) {
     }
 }
 
-// How many `hybridctl plan` processes a worker started are running (their part lies in a
-// job directory, /tmp/hybridctl-cell-job-*).
-int plans_running() {
-  int n = 0;
+// The `hybridctl plan` processes whose parent is `parent` (a worker's planning child).
+// Only this worker's: other cell tests may be planning beside this one.
+std::vector<pid_t> plan_children_of(pid_t parent) {
+  std::vector<pid_t> children;
   for (const fs::directory_entry& e : fs::directory_iterator("/proc")) {
+    const std::string name = e.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    const std::string stat = slurp(e.path() / "stat");  // "pid (comm) state ppid ..."
+    const auto after_comm = stat.rfind(')');
+    if (after_comm == std::string::npos) continue;
+    std::istringstream rest(stat.substr(after_comm + 1));
+    char state = 0;
+    pid_t ppid = 0;
+    rest >> state >> ppid;
     const std::string cmdline = slurp(e.path() / "cmdline");  // arguments separated by NULs
-    if (cmdline.find(std::string("\0plan\0", 6)) != std::string::npos && cmdline.find("/hybridctl-cell-job-") != std::string::npos) ++n;
+    if (ppid == parent && cmdline.find(std::string("\0plan\0", 6)) != std::string::npos) children.push_back(std::stoi(name));
   }
-  return n;
+  return children;
+}
+
+// Whether the process runs (a zombie no longer does: it only waits to be reaped).
+bool running(pid_t pid) {
+  const std::string stat = slurp(fs::path("/proc") / std::to_string(pid) / "stat");
+  const auto after_comm = stat.rfind(')');
+  return after_comm != std::string::npos && after_comm + 2 < stat.size() && stat[after_comm + 2] != 'Z';
 }
 
 // A process of the test's (a plan worker), its output in files.
@@ -202,11 +220,21 @@ TEST_F(Cell, AWorkerKilledMidPlanLosesItsLeaseAndAnotherPlansTheJobOnce) {
   const std::int64_t job = submit(kSource / "examples/parts/flanged-hub.stl", "--voxel 0.5 --top 1");
   auto first = std::make_unique<Process>(worker_command("--name first --lease 3"), dir_ / "first.out");
   ASSERT_TRUE(becomes("SELECT state FROM cell_jobs", "planning", 60)) << slurp(dir_ / "first.out");
+  std::vector<pid_t> plan;
+  for (int i = 0; i < 200 && plan.empty(); ++i) {
+    plan = plan_children_of(first->pid);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_EQ(plan.size(), 1u) << "the worker started no `plan`: " << slurp(dir_ / "first.out");
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   kill(first->pid, SIGKILL);  // the worker, not its `plan` child: that one must die with it
   first->wait(10);
-  std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  EXPECT_EQ(plans_running(), 0) << "the killed worker's `plan` plans on (PR_SET_PDEATHSIG)";
+  bool plan_ended = false;
+  for (int i = 0; i < 100 && !plan_ended; ++i) {
+    plan_ended = !running(plan.front());
+    if (!plan_ended) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_TRUE(plan_ended) << "the killed worker's `plan` plans on (PR_SET_PDEATHSIG)";
   Process second(worker_command("--drain --name second --lease 3"), dir_ / "second.out");
   EXPECT_EQ(second.wait(900), 0) << slurp(dir_ / "second.out");
   EXPECT_EQ(value("SELECT state || ' ' || attempts || ' ' || worker FROM cell_jobs WHERE id = " + std::to_string(job)),
