@@ -73,7 +73,7 @@ std::optional<ControllerLoss> detect_loss(const StreamKnowledge& known, const pr
   return std::nullopt;
 }
 
-std::string describe_loss(const ControllerLoss& l, const std::string& job_dir) {
+std::string describe_loss(const ControllerLoss& l, const std::string& resume_command) {
   const std::uint32_t e = l.executed_line, a = l.accepted_line, n = l.program_lines;
   std::string s = "controller lost the program: " + l.what + ".\n";
   s += "  executed    " + (e ? span(1, e) + ", as the controller reported them" : std::string("no line reported executed")) + "\n";
@@ -82,7 +82,7 @@ std::string describe_loss(const ControllerLoss& l, const std::string& job_dir) {
          " lines) were accepted but not reported executed: they may have run, in part or whole\n";
   if (a < n) s += "  lost        the controller lost the rest of the program (" + span(a + 1, n) + " were never sent)\n";
   s += "  what to do  check the machine (position, tool, the part: how far the last lines got); then\n";
-  s += "              hybridctl run --resume " + (job_dir.empty() ? std::string("JOB") : job_dir) + " --from-line " +
+  s += "              " + (resume_command.empty() ? std::string("hybridctl run --resume JOB") : resume_command) + " --from-line " +
        std::to_string(e + 1) + "\n";
   s += "              (line " + std::to_string(e + 1) + ": the safe point after the last line reported executed";
   if (a > e) s += "; a later line up to " + std::to_string(a + 1) + " if the machine shows the uncertain lines ran";

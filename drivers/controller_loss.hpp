@@ -41,8 +41,9 @@ std::string_view to_string(ControllerLoss::Kind kind);
 std::optional<ControllerLoss> detect_loss(const StreamKnowledge& known, const protocol::Status& now, std::uint32_t program_lines);
 
 // What the operator reads: what happened, which lines ran, which may have, that the
-// controller lost the rest, and the command that goes on (`job_dir` empty: no journal).
-std::string describe_loss(const ControllerLoss& loss, const std::string& job_dir);
+// controller lost the rest, and the command that goes on: `resume_command` (the job's
+// record's, JobRecord::resume_command) with --from-line; empty: there is no record.
+std::string describe_loss(const ControllerLoss& loss, const std::string& resume_command);
 
 // The lines `run --resume DIR --from-line N` may start at after a loss: the protocol's
 // safe point executed_line + 1, or a later line of the uncertain span when the machine

@@ -40,7 +40,8 @@ struct Job {
   config::Machine machine;
   std::string embedded_machine;    // a plan's machine text when no machine file was given: kept in the job directory
   JournalHeader header;
-  std::optional<Journal> journal;
+  std::optional<Journal> journal;  // `run`'s own record; the cell's is the caller's
+  JobRecord* record = nullptr;     // the journal, or the caller's record
   std::string text;                // as read or posted: what `gcode check` reads
   gcode::PostedProgram program;    // its lines as streamed, with its action table
 };
@@ -97,9 +98,8 @@ void assemble_new_job(const JobRequest& request, Job& job, JobOperator& op) {
 
 // The program must be clean for this machine before anything moves. Returns its
 // estimated time.
-double precheck(const JobRequest& request, const Job& job, JobOperator& op) {
-  const gcode::CheckReport check =
-      gcode::check_program(job.text, job.machine, job.header.program.empty() ? request.input : job.header.program);
+double precheck(const std::string& name, const Job& job, JobOperator& op) {
+  const gcode::CheckReport check = gcode::check_program(job.text, job.machine, name);
   if (!check.clean()) {
     op.check_failed(check);
     throw InputError("the program does not pass `gcode check` for machine '" + job.machine.name + "': nothing was sent");
@@ -272,9 +272,9 @@ JobResult stream_job(Job& job, JobOperator& op, double wait_for_controller_s) {
   StreamOptions options;
   options.resume = job.resumed && !job.restarted;
   options.controller_back_within_s = wait_for_controller_s;
-  options.resume_host_hold = options.resume && job.journal->progress().held_by_host;
+  options.resume_host_hold = options.resume && job.record->progress().held_by_host;
   JobResult result;
-  result.stream = stream_program(*transport, job.program.lines, options, cb, &*job.journal);
+  result.stream = stream_program(*transport, job.program.lines, options, cb, job.record);
   result.seconds = seconds_between(begun, Clock::now());
   result.transport = transport->counters();
   result.lines = executable_lines(job.program.lines);
@@ -293,11 +293,27 @@ JobResult execute_job(const JobRequest& request, JobOperator& op) {
   else
     assemble_new_job(request, job, op);
   const std::uint64_t identity = protocol::program_identity(job.program.lines);
-  const double estimated_s = precheck(request, job, op);
+  const double estimated_s = precheck(job.header.program.empty() ? request.input : job.header.program, job, op);
   open_journal(request, job, identity);
+  job.record = &*job.journal;
   op.started({job.journal->file().parent_path().string(), job.header.program, job.program.lines.size(), identity,
               job.machine.name, job.header.transport, estimated_s});
   return stream_job(job, op, request.wait_for_controller_s);
+}
+
+JobResult execute_recorded_job(const RecordedJob& recorded, JobOperator& op) {
+  Job job;
+  job.resumed = recorded.resume;
+  job.machine = recorded.machine;
+  job.text = recorded.program_text;
+  job.program = gcode::PostedProgram::from_lines(protocol::program_lines(job.text));
+  job.header.transport = recorded.transport;
+  job.record = recorded.record;
+  const std::uint64_t identity = protocol::program_identity(job.program.lines);
+  const double estimated_s = precheck(recorded.program_name, job, op);
+  op.started({recorded.name, recorded.program_name, job.program.lines.size(), identity, job.machine.name, recorded.transport,
+              estimated_s});
+  return stream_job(job, op, recorded.wait_for_controller_s);
 }
 
 }  // namespace hybridctl::drivers

@@ -20,6 +20,8 @@
 #include <utility>
 #include <vector>
 
+#include "config/machine.hpp"
+#include "drivers/job_record.hpp"
 #include "drivers/streamer.hpp"
 #include "gcode/post.hpp"
 #include "plan/plan_file.hpp"
@@ -111,9 +113,24 @@ class JobOperator {
   virtual bool resume_after_hold(const protocol::Status& status) = 0;
 };
 
+/// A job whose program and record the caller keeps: the shop cell's machine host, with the
+/// program and its progress in the database (cell/stream_journal.hpp).
+struct RecordedJob {
+  config::Machine machine;
+  std::string program_text;  ///< the program as streamed (a restart's, after a controller loss)
+  std::string program_name;  ///< for people and `gcode check`'s messages
+  std::string name;          ///< the job, for people (JobStart::job_directory)
+  std::string transport;     ///< URI
+  JobRecord* record = nullptr;
+  bool resume = false;       ///< continue where the controller is (a host died mid-program)
+  double wait_for_controller_s = 120;
+};
+
 /// Runs the job to its end or its stop. Throws InputError for bad input (a program that
 /// fails its check, a resume into another program; nothing was sent), TransportError when
 /// the controller cannot be reached (the journal lets a later run resume).
 JobResult execute_job(const JobRequest& request, JobOperator& op);
+/// The same for a job the caller records; the same exceptions.
+JobResult execute_recorded_job(const RecordedJob& job, JobOperator& op);
 
 }  // namespace hybridctl::drivers

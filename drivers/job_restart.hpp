@@ -4,8 +4,11 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "config/machine.hpp"
+#include "drivers/job_record.hpp"
+#include "gcode/restart.hpp"
 
 namespace hybridctl::drivers {
 
@@ -17,5 +20,12 @@ class Journal;
 // writes it next to the journal as program-from-line-N.ngc, and records it in the
 // journal, whose header then names it. Returns the restart program's text.
 std::string restart_job(Journal& journal, const config::Machine& machine, std::uint32_t from_line);
+
+// The restart itself, wherever the job is recorded: `original` the job's original program,
+// `restart_from_line` and `preamble_lines` those of the restart it runs now (0: none),
+// `progress` what its record says of that program.
+gcode::RestartProgram restart_for(const std::vector<std::string>& original, std::uint32_t restart_from_line,
+                                  std::uint32_t preamble_lines, const JournalProgress& progress,
+                                  const config::Machine& machine, std::uint32_t from_line);
 
 }  // namespace hybridctl::drivers

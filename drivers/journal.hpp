@@ -14,6 +14,8 @@
 #include <optional>
 #include <string>
 
+#include "drivers/job_record.hpp"
+
 namespace hybridctl::drivers {
 
 struct JournalHeader {
@@ -30,21 +32,7 @@ struct JournalHeader {
   std::string original_program;  // the program the restart was made from
 };
 
-struct JournalProgress {
-  std::uint32_t last_chunk = 0;  // last acknowledged chunk
-  std::uint32_t through_line = 0;
-  std::uint32_t executed_line = 0;  // last executed line seen in a status
-  bool completed = false;
-  // The controller lost the program (docs/drivers.md "Controller power loss"): what it had
-  // reported executed and accepted then.
-  bool lost = false;
-  std::uint32_t lost_executed_line = 0, lost_accepted_line = 0;
-  // The host held the feed and stopped (the journal could not be written): a resume
-  // sends RESUME once the controller's buffer is refilled.
-  bool held_by_host = false;
-};
-
-class Journal {
+class Journal : public JobRecord {
  public:
   // Starts a new journal in `directory` (made if missing; an existing journal there is
   // refused: a job directory holds one job).
@@ -55,32 +43,35 @@ class Journal {
 
   Journal(Journal&&) noexcept;
   Journal& operator=(Journal&&) noexcept;
-  ~Journal();
+  ~Journal() override;
 
   const JournalHeader& header() const { return header_; }
-  const JournalProgress& progress() const { return progress_; }
+  const JournalProgress& progress() const override { return progress_; }
   std::filesystem::path file() const { return path_; }
 
   // Records an acknowledged chunk. The file is synced in the background within
   // `sync_period_s` (and at once at the end): the controller, not the journal, says
   // where to go on.
-  void acknowledged(std::uint32_t chunk, std::uint32_t through_line, std::uint32_t executed_line);
+  void acknowledged(std::uint32_t chunk, std::uint32_t through_line, std::uint32_t executed_line) override;
   double sync_period_s = 0.1;
   // Free-form events (reconnects, reboots, alarms), not fsync'd on their own.
-  void note(const std::string& event);
-  void completed(std::uint32_t executed_line);
+  void note(const std::string& event) override;
+  void completed(std::uint32_t executed_line) override;
   // The controller lost the program: synced at once.
-  void lost(const std::string& kind, const std::string& what, std::uint32_t executed_line, std::uint32_t accepted_line);
+  void lost(const std::string& kind, const std::string& what, std::uint32_t executed_line, std::uint32_t accepted_line) override;
   // The job goes on as a new program (`run --resume --from-line`): the header's program,
   // identity and line count become the restart's; synced at once.
   void restarted(const std::string& program, std::uint64_t identity, std::uint32_t lines, std::uint32_t from_line,
                  std::uint32_t preamble_lines, const std::string& original_program);
   // The host held the feed because it cannot record what it sends (the disk is full).
-  void held_by_host(const std::string& why);
+  void held_by_host(const std::string& why) override;
   // Whether the journal can still record: false after a write failed (ENOSPC). The entry
   // that failed was written after freeing the journal's reserve (journal.reserve, made
   // at create), so nothing sent goes unrecorded; the streamer then stops sending.
-  bool writable() const { return !write_failed_; }
+  bool writable() const override { return !write_failed_; }
+  std::string why_unwritable() const override { return "the journal " + path_.string() + " cannot be written (disk full)"; }
+  std::string resume_command() const override { return "hybridctl run --resume " + path_.parent_path().string(); }
+  std::string before_resuming() const override { return "Free space"; }
 
  private:
   struct BackgroundSync;

@@ -6,7 +6,7 @@
 
 #include "common/error.hpp"
 #include "drivers/backoff.hpp"
-#include "drivers/journal.hpp"
+#include "drivers/job_record.hpp"
 #include "protocol/chunk.hpp"
 #include "protocol/chunk_acceptor.hpp"
 
@@ -46,21 +46,21 @@ struct Lost {
 
 class Session {
  public:
-  Session(Transport& t, std::span<const std::string> lines, const StreamOptions& o, const StreamCallbacks& cb, Journal* j)
-      : t_(t), lines_(lines), options_(o), cb_(cb), journal_(j), identity_(protocol::program_identity(lines)) {}
+  Session(Transport& t, std::span<const std::string> lines, const StreamOptions& o, const StreamCallbacks& cb, JobRecord* r)
+      : t_(t), lines_(lines), options_(o), cb_(cb), record_(r), identity_(protocol::program_identity(lines)) {}
 
   StreamResult run() {
     try {
       stream();
     } catch (const Lost& l) {
       result_.loss = l.loss;
-      result_.stopped_because = describe_loss(l.loss, journal_ ? journal_->file().parent_path().string() : std::string());
-      if (journal_) journal_->lost(std::string(to_string(l.loss.kind)), l.loss.what, l.loss.executed_line, l.loss.accepted_line);
+      result_.stopped_because = describe_loss(l.loss, record_ ? record_->resume_command() : std::string());
+      if (record_) record_->lost(std::string(to_string(l.loss.kind)), l.loss.what, l.loss.executed_line, l.loss.accepted_line);
     }
     result_.final_status = status_;
     // After a loss the new controller's status says nothing of this program's lines.
     if (result_.loss) result_.final_status.last_executed_line = result_.loss->executed_line;
-    if (journal_ && result_.completed) journal_->completed(status_.last_executed_line);
+    if (record_ && result_.completed) record_->completed(status_.last_executed_line);
     return result_;
   }
 
@@ -176,21 +176,21 @@ class Session {
     waiting_since_ = now;
     note("waiting: " + what);
   }
-  // The journal could not record (the disk is full): send nothing more, hold the feed
-  // where the machine is, and stop; `run --resume` goes on once there is space.
+  // The record could not be kept (the disk is full, the cell's database lost): send
+  // nothing more, hold the feed where the machine is, and stop; the resume command goes on
+  // once the record can be kept again.
   void stop_unrecorded() {
     command(CommandCode::FeedHold);
-    if (journal_) journal_->held_by_host("the journal cannot be written (disk full)");
-    result_.stopped_because = "the journal " + (journal_ ? journal_->file().string() : std::string()) +
-                              " cannot be written (disk full): the feed is held after line " +
+    record_->held_by_host(record_->why_unwritable());
+    result_.stopped_because = record_->why_unwritable() + ": the feed is held after line " +
                               std::to_string(status_.last_executed_line) + "; every chunk sent is recorded through line " +
-                              std::to_string(known_.accepted_line) + ". Free space, then hybridctl run --resume " +
-                              (journal_ ? journal_->file().parent_path().string() : std::string("JOB"));
+                              std::to_string(known_.accepted_line) + ". " + record_->before_resuming() + ", then " +
+                              record_->resume_command();
   }
 
   void note(const std::string& s) {
     if (cb_.note) cb_.note(s);
-    if (journal_) journal_->note(s);
+    if (record_) record_->note(s);
   }
   // A warning is reported in the status while the controller goes on: said once per code
   // and line (polling sees the latest one only; the controller's own log has them all).
@@ -243,13 +243,13 @@ class Session {
     const ControllerState st = status_.state;
     const bool free = st == ControllerState::Idle || st == ControllerState::Completed || st == ControllerState::Aborted;
     if (options_.resume) {
-      if (status_.identity == 0 && journal_ && journal_->progress().through_line > 0) {
-        // The journal says lines went there; the controller has none of them.
-        known_.executed_line = journal_->progress().executed_line;
-        known_.accepted_line = journal_->progress().through_line;
+      if (status_.identity == 0 && record_ && record_->progress().through_line > 0) {
+        // The record says lines went there; the controller has none of them.
+        known_.executed_line = record_->progress().executed_line;
+        known_.accepted_line = record_->progress().through_line;
         throw Lost{{ControllerLoss::Kind::NewBootWithoutProgram,
                     "the controller holds no program (boot " + std::to_string(status_.boot_count) + ", state " +
-                        std::string(protocol::to_string(st)) + ") while the journal records lines 1.." +
+                        std::string(protocol::to_string(st)) + ") while the job's record has lines 1.." +
                         std::to_string(known_.accepted_line) + " accepted",
                     known_.executed_line, known_.accepted_line, std::uint32_t(lines_.size())}};
       }
@@ -313,9 +313,9 @@ class Session {
       if (r == ResultCode::Accepted) {
         ++result_.counters.chunks_accepted;
         known_.accepted_line = c.first_line + c.line_count - 1;
-        if (journal_) journal_->acknowledged(c.seq, c.first_line + c.line_count - 1, status_.last_executed_line);
+        if (record_) record_->acknowledged(c.seq, c.first_line + c.line_count - 1, status_.last_executed_line);
         more_to_send_ = sent + 1 == kChunksPerRound;
-        if (journal_ && !journal_->writable()) return;
+        if (record_ && !record_->writable()) return;
       } else if (r == ResultCode::Duplicate) {
         ++result_.counters.duplicates;
       } else if (r == ResultCode::BufferFull) {
@@ -341,7 +341,7 @@ class Session {
 
   // Follows the controller's state; true when the stream is over.
   bool decide() {
-    if (journal_ && !journal_->writable()) {
+    if (record_ && !record_->writable()) {
       stop_unrecorded();
       return true;
     }
@@ -434,7 +434,7 @@ class Session {
   std::span<const std::string> lines_;
   const StreamOptions& options_;
   const StreamCallbacks& cb_;
-  Journal* journal_;
+  JobRecord* record_;
   std::uint64_t identity_;
   protocol::Status status_;
   std::uint16_t boot_ = 0, seq_ = 0, heartbeat_ = 0;
@@ -452,7 +452,7 @@ class Session {
 }  // namespace
 
 StreamResult stream_program(Transport& transport, std::span<const std::string> lines, const StreamOptions& options,
-                            const StreamCallbacks& callbacks, Journal* journal) {
+                            const StreamCallbacks& callbacks, JobRecord* journal) {
   if (lines.empty()) throw InputError("the program is empty: nothing to stream");
   Session session(transport, lines, options, callbacks, journal);
   return session.run();

@@ -22,7 +22,7 @@
 
 namespace hybridctl::drivers {
 
-class Journal;
+class JobRecord;
 
 // What the streamer asks of its user when the program needs a decision.
 struct StreamCallbacks {
@@ -94,6 +94,6 @@ struct StreamResult {
 // run resume), InputError when the controller holds another program and `resume` asks
 // for this one, or it is busy with another program.
 StreamResult stream_program(Transport& transport, std::span<const std::string> lines, const StreamOptions& options,
-                            const StreamCallbacks& callbacks, Journal* journal = nullptr);
+                            const StreamCallbacks& callbacks, JobRecord* record = nullptr);
 
 }  // namespace hybridctl::drivers

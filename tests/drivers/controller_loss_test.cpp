@@ -71,7 +71,7 @@ TEST(ControllerLoss, APoliteRebootOntoTheSafePointAndAnUnstartedProgramAreNoLoss
 
 TEST(ControllerLoss, TheMessageNamesTheExecutedLinesTheUncertainSpanAndTheCommand) {
   const auto l = detect_loss(kRunning, status(2, 0, ControllerState::Idle, 0, 0), 30000);
-  const std::string m = describe_loss(*l, "/jobs/a");
+  const std::string m = describe_loss(*l, "hybridctl run --resume /jobs/a");
   EXPECT_NE(m.find("executed    lines 1..3000"), std::string::npos) << m;
   EXPECT_NE(m.find("uncertain   lines 3001..4500 (1500 lines)"), std::string::npos) << m;
   EXPECT_NE(m.find("lines 4501..30000 were never sent"), std::string::npos) << m;
