@@ -1,5 +1,6 @@
 #include "cell/jobs.hpp"
 
+#include <fstream>
 #include <nlohmann/json.hpp>
 
 #include "common/error.hpp"
@@ -183,6 +184,21 @@ std::vector<std::pair<std::string, std::string>> job_files(Database& db, std::in
   std::vector<std::pair<std::string, std::string>> out;
   for (int r = 0; r < rows.size(); ++r) out.emplace_back(rows.text(r, 0), rows.bytes(r, 1));
   return out;
+}
+
+void write_job_files(const std::vector<std::pair<std::string, std::string>>& files, const std::filesystem::path& directory,
+                     const std::string& whose) {
+  std::filesystem::create_directories(directory);
+  const std::string inside = directory.lexically_normal().string();
+  for (const auto& [path, content] : files) {
+    const std::filesystem::path p = directory / path;
+    if (p.lexically_normal().string().rfind(inside, 0) != 0)
+      throw InputError(whose + ": stored file \"" + path + "\" lies outside the job's directory");
+    std::filesystem::create_directories(p.parent_path());
+    std::ofstream out(p, std::ios::binary);
+    out << content;
+    if (!out.flush()) throw InputError(p.string() + ": cannot be written");
+  }
 }
 
 }  // namespace hybridctl::cell

@@ -7,6 +7,7 @@
 // when its lease has run out; after `max_attempts` plannings that never finished it fails.
 
 #include <cstdint>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <utility>
@@ -88,5 +89,9 @@ std::vector<std::pair<std::string, std::int64_t>> jobs_per_state(Database& db);
 // A job's stored files; throws InputError for a job that does not exist.
 JobRow job(Database& db, std::int64_t id);
 std::vector<std::pair<std::string, std::string>> job_files(Database& db, std::int64_t id);
+// Writes them into `directory` (made if missing) by their stored paths; throws InputError
+// for a path that would lie outside it (`whose`: the job, in the message).
+void write_job_files(const std::vector<std::pair<std::string, std::string>>& files, const std::filesystem::path& directory,
+                     const std::string& whose);
 
 }  // namespace hybridctl::cell

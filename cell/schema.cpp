@@ -57,6 +57,39 @@ CREATE INDEX cell_job_events_job ON cell_job_events (job);
 -- The jobs' parts and plans are the shop's: the cell's role (the owner) alone reads them.
 REVOKE ALL ON cell_schema, cell_machines, cell_jobs, cell_job_files, cell_job_events FROM PUBLIC;
 )sql"},
+      {2, "machine hosts: the machines' leases, the jobs bound to them with their programs and progress",
+       R"sql(
+ALTER TABLE cell_jobs DROP CONSTRAINT cell_jobs_state_check;
+ALTER TABLE cell_jobs ADD CONSTRAINT cell_jobs_state_check
+  CHECK (state IN ('queued', 'planning', 'planned', 'refused', 'failed', 'streaming', 'done'));
+-- A machine runs one program at a time: at most one job is bound to it.
+CREATE UNIQUE INDEX cell_jobs_bound_to_machine ON cell_jobs (machine) WHERE state = 'streaming';
+ALTER TABLE cell_machines
+  ADD COLUMN host text,                 -- the machine host that drives it
+  ADD COLUMN host_lease_until timestamptz;
+CREATE TABLE cell_streams (
+  job            bigint PRIMARY KEY REFERENCES cell_jobs (id) ON DELETE CASCADE,
+  plan_rank      integer NOT NULL,
+  original       text NOT NULL,         -- the program as exported and proven
+  program        text NOT NULL,         -- as streamed: the original, or its restart after a controller loss
+  identity       text NOT NULL,         -- of `program` (protocol::program_identity), hex
+  lines          integer NOT NULL,
+  restart_from_line      integer NOT NULL DEFAULT 0,
+  restart_preamble_lines integer NOT NULL DEFAULT 0,
+  host           text NOT NULL,         -- the host that streams it, or last did
+  last_chunk     bigint NOT NULL DEFAULT 0,
+  through_line   bigint NOT NULL DEFAULT 0,
+  executed_line  bigint NOT NULL DEFAULT 0,
+  completed      boolean NOT NULL DEFAULT false,
+  lost           boolean NOT NULL DEFAULT false,
+  lost_executed_line bigint NOT NULL DEFAULT 0,
+  lost_accepted_line bigint NOT NULL DEFAULT 0,
+  held_by_host   boolean NOT NULL DEFAULT false,
+  started_at     timestamptz NOT NULL DEFAULT now(),
+  updated_at     timestamptz NOT NULL DEFAULT now()
+);
+REVOKE ALL ON cell_streams FROM PUBLIC;
+)sql"},
   };
   return all;
 }

@@ -13,6 +13,8 @@
 
 #include "cell/jobs.hpp"
 #include "cell/schema.hpp"
+#include "cell/streams.hpp"
+#include "cli/cell_machine_host.hpp"
 #include "cli/cell_plan_worker.hpp"
 #include "cli/commands.hpp"
 #include "cli/ranges.hpp"
@@ -33,6 +35,7 @@ struct CellArgs {
   double voxel = 0, tolerance = -1;
   int top = 0;
   PlanWorkerOptions worker;
+  MachineHostOptions host;
   bool watch = false;
   int limit = 20;
   std::int64_t job = 0;
@@ -96,7 +99,25 @@ int submit(const CellArgs& a) {
   return kSuccess;
 }
 
+// Each machine: its host, and the job bound to it with how far the controller got.
+void print_machines(cell::Database& db) {
+  std::printf("machines:\n");
+  for (const cell::MachineState& m : cell::machine_states(db)) {
+    std::string host = m.host.empty() ? "no host" : "host " + m.host + " (lease " + std::to_string(int(m.lease_left_s)) + " s)";
+    std::printf("  %-16s %-36s", m.name.c_str(), host.c_str());
+    if (m.job == 0) {
+      std::printf(" idle\n");
+      continue;
+    }
+    const double done = m.lines ? 100.0 * m.executed_line / m.lines : 0;
+    std::printf(" job %lld (%s) line %u/%u (%.0f %%), sent through %u, recorded %.0f s ago%s%s\n", static_cast<long long>(m.job),
+                m.part_name.c_str(), m.executed_line, m.lines, done, m.through_line, m.since_update_s,
+                m.reason.empty() ? "" : "; stopped: ", m.reason.substr(0, m.reason.find('\n')).c_str());
+  }
+}
+
 void print_status(cell::Database& db, int limit) {
+  print_machines(db);
   std::printf("jobs:");
   for (const auto& [state, count] : cell::jobs_per_state(db)) std::printf(" %s %lld", state.c_str(), static_cast<long long>(count));
   std::printf("\n%6s  %-16s %-24s %-9s %8s  %-22s %s\n", "job", "machine", "part", "state", "attempts", "worker", "reason");
@@ -133,15 +154,8 @@ int report(const CellArgs& a) {
   std::error_code ec;
   if (fs::exists(target, ec)) throw InputError(a.output + ": exists; give a new directory for the job's files");
   const fs::path temp = target.parent_path() / ("." + target.filename().string() + ".tmp-" + std::to_string(getpid()));
-  fs::create_directories(temp);
   try {
-    for (const auto& [path, content] : files) {
-      const fs::path p = temp / path;
-      if (p.lexically_normal().string().rfind(temp.lexically_normal().string(), 0) != 0)
-        throw InputError("job " + std::to_string(a.job) + ": stored file \"" + path + "\" lies outside the job's directory");
-      fs::create_directories(p.parent_path());
-      std::ofstream(p, std::ios::binary) << content;
-    }
+    cell::write_job_files(files, temp, "job " + std::to_string(a.job));
     fs::rename(temp, target);
   } catch (...) {
     fs::remove_all(temp, ec);
@@ -164,8 +178,8 @@ void add_db_option(CLI::App* cmd, std::string& db) {
 
 void add_cell_command(CLI::App& app, Runner& runner) {
   auto a = std::make_shared<CellArgs>();
-  auto* cell = app.add_subcommand("cell", "A shop cell on PostgreSQL: machines, a queue of parts, plan workers on any host "
-                                          "(docs/cell.md)");
+  auto* cell = app.add_subcommand("cell", "A shop cell on PostgreSQL: machines, a queue of parts, plan workers on any host, a host "
+                                          "per machine streaming its jobs (docs/cell.md)");
   cell->require_subcommand(1);
   auto on = [&runner, a](CLI::App* cmd, int (*fn)(const CellArgs&)) {
     add_db_option(cmd, a->db);
@@ -200,7 +214,37 @@ void add_cell_command(CLI::App& app, Runner& runner) {
     o.db = args.db;
     return run_plan_worker(o);
   });
-  auto* st = cell->add_subcommand("status", "The queue: jobs per state and the newest jobs with their workers and reasons");
+  auto* mh = cell->add_subcommand("machine-host",
+                                   "Drive one machine: resume the job bound to it if its host died, then stream its planned "
+                                   "jobs in order, each exactly once, the progress recorded in the database (exit 5 when the "
+                                   "machine stopped first: the job stays bound to it)");
+  mh->add_option("-m,--machine", a->host.machine, "The machine's name in the cell")->required();
+  mh->add_option("--name", a->host.name, "How this host signs its lease on the machine (default: host:pid)");
+  mh->add_option("-t,--transport", a->host.transport, "The controller's URI (default: the machine's registered one)");
+  mh->add_option("--lease", a->host.lease_s,
+                 "Seconds the host's lease on the machine lasts unless renewed; a host gone that long leaves the machine "
+                 "to the next")
+      ->capture_default_str()
+      ->check(between(2.0, 3600.0));
+  mh->add_option("--plan", a->host.plan_rank, "Which of each job's plans to run, by rank")->capture_default_str()->check(greater_than(0));
+  mh->add_option("--from-line", a->host.from_line,
+                 "After the controller lost the bound job's program: restart it at this line (the line the loss "
+                 "message names, after checking the machine)")
+      ->check(greater_than(0));
+  mh->add_option("--wait-for-controller", a->host.wait_for_controller_s,
+                 "Seconds to wait for a controller that stops answering mid-program before giving up (exit 6; the job "
+                 "stays bound)")
+      ->capture_default_str()
+      ->check(between(0.0, 86400.0));
+  mh->add_flag("-y,--yes", a->host.yes,
+               "Unattended: stream each job without asking, continue after program stops, clear recoverable alarms");
+  mh->add_flag("--drain", a->host.drain, "End when the machine has no planned job left instead of waiting for more");
+  on(mh, [](const CellArgs& args) {
+    MachineHostOptions o = args.host;
+    o.db = args.db;
+    return run_machine_host(o);
+  });
+  auto* st = cell->add_subcommand("status", "The machines with their hosts and bound jobs' progress; the queue: jobs per state and the newest jobs with their workers and reasons");
   st->add_flag("--watch", a->watch, "Print again whenever a job is submitted or finished, until interrupted");
   st->add_option("--limit", a->limit, "How many jobs to list")->capture_default_str()->check(between(1, 10000));
   on(st, status);

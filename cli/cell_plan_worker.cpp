@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "cell/jobs.hpp"
+#include "cell/reconnecting.hpp"
 #include "cell/schema.hpp"
 #include "cli/commands.hpp"
 #include "gcode/files.hpp"
@@ -35,48 +36,11 @@ void log(const std::string& worker, const std::string& text) {
   std::fflush(stdout);
 }
 
-// The connection, made again whenever it breaks: the database restarted is waited for,
-// not a reason to stop.
-class Connection {
+// The worker's connection: LISTENs for submissions and outcomes, and logs its losses.
+class Connection : public cell::Reconnecting {
  public:
-  Connection(std::string uri, std::string worker) : uri_(std::move(uri)), worker_(std::move(worker)) { open(); }
-  Database& db() { return *db_; }
-
-  // fn(db), again on a fresh connection while the connection is what failed.
-  template <class F>
-  auto retrying(F&& fn) {
-    for (;;) {
-      try {
-        return fn(*db_);
-      } catch (const DatabaseError& e) {
-        if (!e.connection_lost()) throw;
-        log(worker_, std::string("database lost (") + e.what() + "); connecting again");
-        reopen();
-      }
-    }
-  }
-
- private:
-  void open() {
-    db_ = std::make_unique<Database>(uri_);
-    db_->exec("the job channel", "LISTEN cell_jobs");
-    db_->exec("the outcome channel", "LISTEN cell_jobs_done");
-  }
-  void reopen() {
-    for (int attempt = 1;; ++attempt) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(std::min(2000, 200 * attempt)));
-      try {
-        open();
-        log(worker_, "database back");
-        return;
-      } catch (const DatabaseError& e) {
-        if (attempt % 10 == 1) log(worker_, std::string("still no database: ") + e.what());
-      }
-    }
-  }
-
-  std::string uri_, worker_;
-  std::unique_ptr<Database> db_;
+  Connection(const std::string& uri, const std::string& worker)
+      : Reconnecting(uri, {"cell_jobs", "cell_jobs_done"}, [worker](const std::string& text) { log(worker, text); }) {}
 };
 
 // A name the part can have on disk: its file name's letters, digits, dots, dashes.

@@ -41,15 +41,6 @@ std::string hex(std::uint64_t v) {
   return b;
 }
 
-bool ask(const std::string& question) {
-  if (::isatty(STDIN_FILENO) != 1) return false;
-  std::fprintf(stderr, "\n%s [y/N] ", question.c_str());
-  std::fflush(stderr);
-  std::string answer;
-  if (!std::getline(std::cin, answer)) return false;
-  return !answer.empty() && (answer[0] == 'y' || answer[0] == 'Y');
-}
-
 // What a stopped controller waits for, for the status line ("" while it runs).
 std::string waiting_for(const protocol::Status& s) {
   using protocol::ControllerState;
@@ -106,7 +97,7 @@ class TerminalOperator : public drivers::JobOperator {
   bool continue_after_stop(const protocol::Status& s, const std::string& message) override {
     std::fprintf(stderr, "%sprogram stop after line %u: %s\n", tty ? "\n" : "", s.last_executed_line, message.c_str());
     if (yes_) return true;
-    return ask("Operator: done? continue the program");
+    return ask_at_terminal("Operator: done? continue the program");
   }
 
   bool clear_alarm(const protocol::Status& s) override {
@@ -114,14 +105,14 @@ class TerminalOperator : public drivers::JobOperator {
     std::fprintf(stderr, "%salarm %s at line %u: %s\n  what to do: %s\n", tty ? "\n" : "", std::string(info.name).c_str(),
                  unsigned(s.alarm_line), std::string(info.meaning).c_str(), std::string(info.action).c_str());
     if (yes_) return true;
-    return ask("Clear the alarm and resume");
+    return ask_at_terminal("Clear the alarm and resume");
   }
 
   bool hold_requested() override { return interrupted.exchange(false); }
 
   bool resume_after_hold(const protocol::Status&) override {
     std::fprintf(stderr, "%sfeed hold (Ctrl-C)\n", tty ? "\n" : "");
-    return ask("Resume the program (no: abort it)");
+    return ask_at_terminal("Resume the program (no: abort it)");
   }
 
  private:
@@ -188,6 +179,27 @@ int run_job(const RunRequest& request, std::vector<std::pair<std::string, std::u
   print_report(result);
   if (alarms) *alarms = result.alarms;
   return result.stream.completed ? int(kSuccess) : int(kMachineStopped);
+}
+
+bool ask_at_terminal(const std::string& question) {
+  if (::isatty(STDIN_FILENO) != 1) return false;
+  std::fprintf(stderr, "\n%s [y/N] ", question.c_str());
+  std::fflush(stderr);
+  std::string answer;
+  if (!std::getline(std::cin, answer)) return false;
+  return !answer.empty() && (answer[0] == 'y' || answer[0] == 'Y');
+}
+
+drivers::JobResult run_recorded_job(const drivers::RecordedJob& job, bool yes) {
+  TerminalOperator op(yes);
+  drivers::JobResult result;
+  {
+    const SigintHold hold;
+    result = drivers::execute_recorded_job(job, op);
+  }
+  if (op.tty) std::fprintf(stderr, "\n");
+  print_report(result);
+  return result;
 }
 
 void add_run_command(CLI::App& app, Runner& runner) {

@@ -1,12 +1,17 @@
 #pragma once
-// `hybridctl run` at a terminal, shared with `hybridctl dry-run`: the plan executor
-// (drivers/executor.hpp) with its status line, prompts (--yes answers them), Ctrl-C as a
-// feed hold, and the final report printed.
+// `hybridctl run` at a terminal, shared with `hybridctl dry-run` and `cell machine-host`:
+// the plan executor (drivers/executor.hpp) with its status line, prompts (--yes answers
+// them), Ctrl-C as a feed hold, and the final report printed.
 
 #include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
+
+namespace hybridctl::drivers {
+struct RecordedJob;
+struct JobResult;
+}  // namespace hybridctl::drivers
 
 namespace hybridctl::cli {
 
@@ -26,5 +31,13 @@ struct RunRequest {
 // Returns the exit code: kSuccess, or kMachineStopped when the machine stopped first.
 // `alarms`, when given, receives every alarm raised, in order, with its line.
 int run_job(const RunRequest& request, std::vector<std::pair<std::string, std::uint32_t>>* alarms = nullptr);
+
+// The same for a job the shop cell records (`cell machine-host`): status, prompts (`yes`
+// answers them), Ctrl-C, the final report; returns how it ended. Throws as
+// drivers::execute_recorded_job does.
+drivers::JobResult run_recorded_job(const drivers::RecordedJob& job, bool yes);
+
+// A yes-or-no question on the terminal; false without one (stdin not a terminal).
+bool ask_at_terminal(const std::string& question);
 
 }  // namespace hybridctl::cli

@@ -37,6 +37,7 @@ std::string hex(std::uint64_t v) {
 struct Job {
   bool resumed = false;
   bool restarted = false;          // resumed at --from-line as a new program (the controller lost it)
+  bool resume_when_ours = false;   // StreamOptions::resume_when_ours
   config::Machine machine;
   std::string embedded_machine;    // a plan's machine text when no machine file was given: kept in the job directory
   JournalHeader header;
@@ -271,6 +272,7 @@ JobResult stream_job(Job& job, JobOperator& op, double wait_for_controller_s) {
   const StreamCallbacks cb = stream_callbacks(op, actions, job.program.lines, begun);
   StreamOptions options;
   options.resume = job.resumed && !job.restarted;
+  options.resume_when_ours = job.resume_when_ours;
   options.controller_back_within_s = wait_for_controller_s;
   options.resume_host_hold = options.resume && job.record->progress().held_by_host;
   JobResult result;
@@ -304,6 +306,7 @@ JobResult execute_job(const JobRequest& request, JobOperator& op) {
 JobResult execute_recorded_job(const RecordedJob& recorded, JobOperator& op) {
   Job job;
   job.resumed = recorded.resume;
+  job.resume_when_ours = true;
   job.machine = recorded.machine;
   job.text = recorded.program_text;
   job.program = gcode::PostedProgram::from_lines(protocol::program_lines(job.text));

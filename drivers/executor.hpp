@@ -114,7 +114,9 @@ class JobOperator {
 };
 
 /// A job whose program and record the caller keeps: the shop cell's machine host, with the
-/// program and its progress in the database (cell/stream_journal.hpp).
+/// program and its progress in the database (cell/stream_journal.hpp). Its program's
+/// identity must be its job's alone: a controller found holding it resumes it
+/// (StreamOptions::resume_when_ours).
 struct RecordedJob {
   config::Machine machine;
   std::string program_text;  ///< the program as streamed (a restart's, after a controller loss)
@@ -122,7 +124,7 @@ struct RecordedJob {
   std::string name;          ///< the job, for people (JobStart::job_directory)
   std::string transport;     ///< URI
   JobRecord* record = nullptr;
-  bool resume = false;       ///< continue where the controller is (a host died mid-program)
+  bool resume = false;       ///< the record says lines were sent: the controller must hold the program
   double wait_for_controller_s = 120;
 };
 

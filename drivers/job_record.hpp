@@ -31,6 +31,10 @@ class JobRecord {
   // An acknowledged chunk. Kept durable within a short period, not before the stream goes
   // on: the controller, not the record, says where to go on.
   virtual void acknowledged(std::uint32_t chunk, std::uint32_t through_line, std::uint32_t executed_line) = 0;
+  // The last line the controller reports executed, at every status read of this program:
+  // for people watching the job elsewhere; a record may keep it or leave it to the next
+  // acknowledgement.
+  virtual void executed(std::uint32_t /*line*/) {}
   // Free-form events (reconnects, reboots, alarms).
   virtual void note(const std::string& event) = 0;
   // Durable at once.

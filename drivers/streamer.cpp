@@ -214,6 +214,7 @@ class Session {
     }
     know(s);
     status_ = s;
+    if (record_ && s.identity == identity_) record_->executed(s.last_executed_line);
     if (cb_.status) cb_.status(s);
     warned(s);
     if (s.boot_count != boot_) {
@@ -242,7 +243,7 @@ class Session {
     const bool ours = status_.identity == identity_;
     const ControllerState st = status_.state;
     const bool free = st == ControllerState::Idle || st == ControllerState::Completed || st == ControllerState::Aborted;
-    if (options_.resume) {
+    if (options_.resume || (options_.resume_when_ours && ours)) {
       if (status_.identity == 0 && record_ && record_->progress().through_line > 0) {
         // The record says lines went there; the controller has none of them.
         known_.executed_line = record_->progress().executed_line;

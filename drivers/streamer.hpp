@@ -50,6 +50,10 @@ struct StreamOptions {
   double poll_period_s = 0.002;     // status polling when there is nothing to send
   // Resume: the controller must hold this very program (its identity); never SET_PROGRAM.
   bool resume = false;
+  // Without `resume`: resume all the same when the controller holds this very program (a
+  // host died after it sent lines its record had not yet kept), else set it. Only for a
+  // program whose identity is its job's alone (the cell's programs name their job).
+  bool resume_when_ours = false;
   // Resume after the host held the feed itself (JournalProgress::held_by_host): RESUME
   // once the controller's buffer is refilled.
   bool resume_host_hold = false;
