@@ -104,19 +104,7 @@ void BM_RawBusFrames(benchmark::State& state) {
   state.counters["vs_theory"] = g_raw_rate / theoretical_payload_rate();
 }
 
-// ~28-byte feed moves inside the example machine's travel; `run` makes each program
-// distinct (its identity), so every iteration is a new program from line 1.
-std::vector<std::string> program(int moves, int run) {
-  std::string p = "(can_bench run " + std::to_string(run) + ")\nG21 G90 G17\nG54\nT1 M6\nS8000 M3\nG0 X0 Y0 Z20\n";
-  char line[64];
-  for (int i = 0; i < moves; ++i) {
-    std::snprintf(line, sizeof line, "G1 X%.3f Y%.3f Z20 F1200\n", 10 + (i * 7919LL % 40000) / 1000.0,
-                  10 + (i * 104729LL % 20000) / 1000.0);
-    p += line;
-  }
-  p += "M5\nM2\n";
-  return protocol::program_lines(p);
-}
+std::vector<std::string> program(int moves, int run) { return bench::feed_moves_program(moves, "can_bench run " + std::to_string(run)); }
 
 // Where the stream's time goes: the seconds spent inside each kind of transport call.
 class TimedTransport final : public drivers::Transport {

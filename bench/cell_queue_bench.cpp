@@ -18,27 +18,15 @@
 #include <thread>
 #include <vector>
 
-#include "cell/jobs.hpp"
-#include "cell/schema.hpp"
+#include "bench/bench_cell.hpp"
 #include "bench/bench_main.hpp"
-#include "tests/cell/postgres_server.hpp"
+#include "cell/jobs.hpp"
 
 namespace {
 
 using namespace hybridctl;
 
-// One server for the program, with the schema and a machine.
-cell::testing::PostgresServer& server() {
-  static cell::testing::PostgresServer s;
-  static const bool ready = [] {
-    cell::Database db(s.uri());
-    cell::migrate(db);
-    cell::add_machine(db, {"mill", "name: mill\n", "0", ""});
-    return true;
-  }();
-  (void)ready;
-  return s;
-}
+cell::testing::PostgresServer& server() { return bench::cell_server(); }
 
 // Seconds for `workers` to claim and finish every queued job.
 double drain(int workers) {
