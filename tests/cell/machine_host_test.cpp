@@ -39,20 +39,28 @@ class MachineHost : public CellTest {
 
   // The simulated controller for the job's stock, at `time_scale` times real time, logging
   // every line it executes; registered as the machine's controller.
-  std::unique_ptr<Process> controller(const std::string& time_scale) {
+  // `name`: its output in NAME.out, its executed lines in NAME.ngc; `port` 0: any free one;
+  // without `stock`, a controller that comes up after a power loss (the part is not its
+  // subject).
+  std::unique_ptr<Process> controller(const std::string& time_scale, const std::string& name = "lines", int port = 0,
+                                      bool stock = true) {
     auto sim = std::make_unique<Process>(
         quote(HYBRIDCTL_EXE) + " sim serve --machine " + quote((kSource / "examples/machines/hybrid-3axis.yaml").string()) +
-            " --stock " + quote((dir_ / "job" / "plan.json").string()) + " --line-log " + quote((dir_ / "lines.ngc").string()) +
-            " --exit-when-done --modbus tcp://127.0.0.1:0 --time-scale " + time_scale,
-        dir_ / "sim.out");
-    int port = 0;
+            (stock ? " --stock " + quote((dir_ / "job" / "plan.json").string()) : std::string()) + " --line-log " +
+            quote((dir_ / (name + ".ngc")).string()) + " --exit-when-done --modbus tcp://127.0.0.1:" + std::to_string(port) +
+            " --time-scale " + time_scale,
+        dir_ / (name + ".out"));
+    const bool given = port != 0;
+    port = 0;
     for (int i = 0; i < 600 && !port; ++i) {
       std::smatch m;
-      const std::string out = slurp(dir_ / "sim.out");
-      if (std::regex_search(out, m, std::regex("listening modbus-tcp 127\\.0\\.0\\.1:([0-9]+)"))) port = std::stoi(m[1]);
+      const std::string out = slurp(dir_ / (name + ".out"));
+      if (std::regex_search(out, m, std::regex("listening modbus-tcp 127\\.0\\.0\\.1:([0-9]+)")) && out.find("ready") != std::string::npos)
+        port = std::stoi(m[1]);
       if (!port) std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
-    EXPECT_GT(port, 0) << slurp(dir_ / "sim.out");
+    EXPECT_GT(port, 0) << slurp(dir_ / (name + ".out"));
+    if (given) return sim;
     const auto added = cell("machines add mill --machine " + quote((kSource / "examples/machines/hybrid-3axis.yaml").string()) +
                             " --transport modbus-tcp://127.0.0.1:" + std::to_string(port));
     EXPECT_EQ(added.exit_code, 0) << added.err;
@@ -64,10 +72,10 @@ class MachineHost : public CellTest {
   }
 
   // The simulated controller executed the job's program, every line once, in order.
-  void expect_every_line_once(Process& sim, std::int64_t job) {
-    EXPECT_EQ(sim.wait(60), 0) << slurp(dir_ / "sim.out");
+  void expect_every_line_once(Process& sim, std::int64_t job, const std::string& name = "lines") {
+    EXPECT_EQ(sim.wait(60), 0) << slurp(dir_ / (name + ".out"));
     const std::string program = value("SELECT program FROM cell_streams WHERE job = " + std::to_string(job));
-    const std::string log = slurp(dir_ / "lines.ngc");
+    const std::string log = slurp(dir_ / (name + ".ngc"));
     EXPECT_GT(std::count(program.begin(), program.end(), '\n'), 200);
     EXPECT_TRUE(log == program) << "the controller executed " << std::count(log.begin(), log.end(), '\n')
                                 << " lines; the program has " << std::count(program.begin(), program.end(), '\n');
@@ -77,19 +85,22 @@ class MachineHost : public CellTest {
   std::string executed_line(std::int64_t job) {
     return value("SELECT executed_line FROM cell_streams WHERE job = " + std::to_string(job));
   }
+  // Waits until the controller has executed more than `line` lines of the job.
+  bool executed_past(std::int64_t job, int line) {
+    for (int i = 0; i < 1200; ++i) {
+      const std::string executed = executed_line(job);
+      if (!executed.empty() && std::stoi(executed) > line) return true;
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return false;
+  }
 };
 
 TEST_F(MachineHost, AHostKilledMidProgramIsResumedByAnotherAndEveryLineRunsOnce) {
   const std::int64_t job = planned_job();
   auto sim = controller("20");
   auto first = std::make_unique<Process>(host_command("--name first --lease 3 --yes --drain"), dir_ / "first.out");
-  bool streaming = false;
-  for (int i = 0; i < 1200 && !streaming; ++i) {
-    const std::string line = executed_line(job);
-    streaming = !line.empty() && std::stoi(line) > 20;
-    if (!streaming) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  ASSERT_TRUE(streaming) << slurp(dir_ / "first.out");
+  ASSERT_TRUE(executed_past(job, 20)) << slurp(dir_ / "first.out");
   kill(first->pid, SIGKILL);
   first->wait(10);
   ASSERT_NE(value("SELECT state FROM cell_jobs WHERE id = " + std::to_string(job)), "done") << "the host finished before it was killed";
@@ -119,19 +130,49 @@ TEST_F(MachineHost, TheDatabaseRestartedMidStreamLosesNoLineAndRunsNoneTwice) {
   const std::int64_t job = planned_job();
   auto sim = controller("20");
   Process host(host_command("--name steady --lease 20 --yes --drain"), dir_ / "host.out");
-  bool streaming = false;
-  for (int i = 0; i < 1200 && !streaming; ++i) {
-    const std::string line = executed_line(job);
-    streaming = !line.empty() && std::stoi(line) > 20;
-    if (!streaming) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  ASSERT_TRUE(streaming) << slurp(dir_ / "host.out");
+  ASSERT_TRUE(executed_past(job, 20)) << slurp(dir_ / "host.out");
   server_->stop();
   std::this_thread::sleep_for(std::chrono::seconds(2));
   server_->start();
   EXPECT_EQ(host.wait(600), 0) << slurp(dir_ / "host.out");
   expect_every_line_once(*sim, job);
   EXPECT_NE(slurp(dir_ / "host.out").find("database back"), std::string::npos) << slurp(dir_ / "host.out");
+}
+
+// A controller power cycle mid-program: the host stops, says what ran and the command that
+// goes on; that command restarts the job's program at the safe point on the new boot.
+TEST_F(MachineHost, AControllerPowerLossStopsTheHostAndFromLineRestartsTheJobOnce) {
+  const std::int64_t job = planned_job();
+  auto first = controller("20", "sim1");
+  const std::string port = value("SELECT substring(transport from '[0-9]+$') FROM cell_machines WHERE name = 'mill'");
+  Process host(host_command("--name steady --lease 20 --yes --drain"), dir_ / "host.out");
+  ASSERT_TRUE(executed_past(job, 100)) << slurp(dir_ / "host.out");
+  kill(first->pid, SIGKILL);
+  first->wait(5);
+  for (int i = 0; i < 1200 && slurp(dir_ / "host.out").find("waiting for it to come back") == std::string::npos; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  auto second = controller("0", "sim2", std::stoi(port), false);
+  EXPECT_EQ(host.wait(60), 5) << slurp(dir_ / "host.out");
+  const std::string out = slurp(dir_ / "host.out");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(out, m, std::regex(R"(hybridctl cell machine-host --machine mill --from-line (\d+))"))) << out;
+  const std::string from = m[1];
+  EXPECT_EQ(value("SELECT lost FROM cell_streams WHERE job = " + std::to_string(job)), "t");
+  EXPECT_EQ(value("SELECT state FROM cell_jobs WHERE id = " + std::to_string(job)), "streaming");
+  EXPECT_NE(value("SELECT reason FROM cell_jobs WHERE id = " + std::to_string(job)).find("controller lost the program"), std::string::npos);
+  const std::string original = value("SELECT original FROM cell_streams WHERE job = " + std::to_string(job));
+
+  Process restart(host_command("--name steady --from-line " + from + " --yes --drain"), dir_ / "restart.out");
+  EXPECT_EQ(restart.wait(120), 0) << slurp(dir_ / "restart.out");
+  // The new boot ran the restart (a preamble, then lines N..end of the original), each once.
+  expect_every_line_once(*second, job, "sim2");
+  const std::string program = value("SELECT program FROM cell_streams WHERE job = " + std::to_string(job));
+  EXPECT_EQ(program.rfind("(restart at line " + from + ":", 0), 0u) << program.substr(0, 200);
+  std::size_t at = 0;
+  for (int l = 1; l < std::stoi(from); ++l) at = original.find('\n', at) + 1;
+  const std::string rest = original.substr(at);
+  ASSERT_GE(program.size(), rest.size());
+  EXPECT_EQ(program.compare(program.size() - rest.size(), rest.size(), rest), 0) << "the restart ends with lines N..end";
 }
 
 TEST_F(MachineHost, BadInputIsRefusedWithWhereAndWhat) {
