@@ -22,6 +22,7 @@
 #include "config/machine_loader.hpp"
 #include "gcode/files.hpp"
 #include "plan/plan_machine.hpp"
+#include "gcode/post.hpp"
 
 namespace hybridctl::cli {
 namespace {
@@ -66,7 +67,7 @@ int machines_add(const CellArgs& a) {
   if (!std::regex_match(a.name, name_rule))
     throw InputError("machine name \"" + a.name + "\": expected 1-64 letters, digits, '.', '_' or '-', starting with a letter or digit");
   const std::string text = config::read_machine_text(a.machine_file);
-  config::parse_machine(text, a.machine_file);  // a machine file that does not load is not registered
+  gcode::parse_postable_machine(text, a.machine_file);  // a machine file that does not load or post is not registered
   cell::Database db(a.db);
   cell::require_current_schema(db);
   cell::add_machine(db, {a.name, text, plan::machine_text_hash(text), a.transport});

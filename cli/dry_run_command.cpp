@@ -36,6 +36,7 @@
 #include "planner/pipeline/plan_report.hpp"
 #include "validation/plan_validator.hpp"
 #include "verification/exact_deviation.hpp"
+#include "gcode/post.hpp"
 
 namespace hybridctl::cli {
 namespace {
@@ -213,7 +214,7 @@ int run_dry_run(const DryRunArgs& a) {
   if (a.transport != "modbus" && a.transport != "can")
     throw InputError("--transport " + a.transport + ": expected modbus or can");
   const std::string machine_text = config::read_machine_text(a.machine);
-  const config::Machine machine = config::parse_machine(machine_text, a.machine);
+  const config::Machine machine = gcode::parse_postable_machine(machine_text, a.machine);
   const fs::path out = a.output;
   fs::create_directories(out);
 

@@ -3,6 +3,7 @@
 
 #include "cli/commands.hpp"
 #include "config/machine_loader.hpp"
+#include "gcode/post.hpp"
 
 namespace hybridctl::cli {
 
@@ -16,7 +17,7 @@ void add_machine_command(CLI::App& app, Runner& runner) {
   check->callback([&runner, file] {
     runner = [file] {
       try {
-        const config::Machine m = config::load_machine(*file);
+        const config::Machine m = gcode::load_postable_machine(*file);
         std::printf("%s: ok\n%s", file->c_str(), config::summarize(m).c_str());
         return int(kSuccess);
       } catch (const config::MachineFileError& e) {

@@ -15,6 +15,7 @@
 #include "planner/pipeline/plan_report.hpp"
 #include "validation/plan_validator.hpp"
 #include "verification/exact_deviation.hpp"
+#include "gcode/post.hpp"
 
 namespace hybridctl::cli {
 namespace {
@@ -56,7 +57,7 @@ int run_plan(const PlanArgs& args) {
   if (args.report && args.output.empty() && args.export_dir.empty())
     throw InputError("--report: the report is made from the plan directory: give -o DIR (or --export DIR)");
   const std::string machine_text = config::read_machine_text(args.machine);
-  const config::Machine machine = config::parse_machine(machine_text, args.machine);
+  const config::Machine machine = gcode::parse_postable_machine(machine_text, args.machine);
   planner::PlanningOptions options;
   options.voxel_size = args.voxel;
   options.memory_budget = memory_budget(args.memory_budget);

@@ -8,11 +8,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <optional>
 #include <cerrno>
 #include <sstream>
 #include <system_error>
 
 #include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/yaml.h>
 
 #include "config/machine_reader.hpp"
 
@@ -124,5 +126,37 @@ std::string read_machine_text(const std::filesystem::path& path) {
 }
 
 Machine load_machine(const std::filesystem::path& path) { return parse_machine(read_machine_text(path), path.string()); }
+
+Diagnostic diagnostic_at(std::string_view yaml_text, const std::string& file_name, std::string_view key_path, std::string message) {
+  Diagnostic d{file_name, 0, 0, std::move(message)};
+  try {
+    YAML::Node node = YAML::Load(std::string(yaml_text));
+    std::size_t at = 0;
+    while (at < key_path.size() && node.IsDefined()) {
+      const std::size_t end = std::min(key_path.find('.', at), key_path.size());
+      std::string_view part = key_path.substr(at, end - at);
+      at = end + 1;
+      std::optional<std::size_t> index;
+      if (const auto open = part.find('['); open != std::string_view::npos) {
+        index = std::stoul(std::string(part.substr(open + 1)));
+        part = part.substr(0, open);
+      }
+      // Node's operator= writes into the node it refers to: reset() moves the reference.
+      YAML::Node next;
+      next.reset(node.IsMap() ? node[std::string(part)] : YAML::Node(YAML::NodeType::Undefined));
+      if (next.IsDefined() && index) {
+        YAML::Node element;
+        element.reset(next.IsSequence() && *index < next.size() ? next[*index] : YAML::Node(YAML::NodeType::Undefined));
+        next.reset(element);
+      }
+      if (!next.IsDefined()) break;
+      node.reset(next);
+      d.line = node.Mark().line + 1;
+      d.column = node.Mark().column + 1;
+    }
+  } catch (const std::exception&) {  // a file that parsed once parses again; if not, the file as a whole
+  }
+  return d;
+}
 
 }  // namespace hybridctl::config

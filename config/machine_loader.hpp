@@ -26,4 +26,9 @@ std::string read_machine_text(const std::filesystem::path& path);
 /// Throws MachineFileError (and nothing else) on any problem.
 Machine parse_machine(std::string_view yaml_text, std::string file_name);
 
+/// A diagnostic about the value at `key_path` ("gcode.m_codes.spindle_cw",
+/// "heads[0].codes.on") of a machine file that parses: at the value's line and column, or
+/// at the deepest key of the path the file writes when it leaves the rest to defaults.
+Diagnostic diagnostic_at(std::string_view yaml_text, const std::string& file_name, std::string_view key_path, std::string message);
+
 }  // namespace hybridctl::config

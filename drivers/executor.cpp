@@ -52,7 +52,7 @@ void open_resumed_job(const JobRequest& request, Job& job) {
   job.journal = Journal::open(request.resume);
   job.header = job.journal->header();
   job.text = gcode::read_text_file(job.header.program);
-  job.machine = config::load_machine(request.machine.empty() ? job.header.machine : request.machine);
+  job.machine = gcode::load_postable_machine(request.machine.empty() ? job.header.machine : request.machine);
   if (request.from_line > 0) {
     job.restarted = true;
     job.text = restart_job(*job.journal, job.machine, request.from_line);
@@ -88,7 +88,7 @@ void assemble_new_job(const JobRequest& request, Job& job, JobOperator& op) {
     job.text = job.program.text();
     job.header.source = in.string() + " plan " + std::to_string(request.rank);
   } else {
-    job.machine = config::load_machine(request.machine);
+    job.machine = gcode::load_postable_machine(request.machine);
     job.text = gcode::read_text_file(in);
     job.program = gcode::PostedProgram::from_lines(protocol::program_lines(job.text));
     job.header.source = in.string();

@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "common/error.hpp"
+#include "config/machine_loader.hpp"
 #include "gcode/check.hpp"
 #include "gcode/files.hpp"
 #include "gcode/interpreter.hpp"
@@ -46,14 +47,16 @@ int leading_m(const std::string& code) {
   return b.m_count == 1 && b.g_count == 0 ? b.m[0].value : -1;
 }
 
-/// The RS274NGC dialect writes only codes LinuxCNC runs. Throws InputError naming the key.
-void require_linuxcnc_codes(const config::Machine& machine) {
-  const std::string where = "machine '" + machine.name + "' (rs274ngc dialect): ";
+}  // namespace
+
+std::optional<PostingProblem> posting_problem(const config::Machine& machine, config::Dialect dialect) {
+  if (dialect != Dialect::Rs274ngc) return std::nullopt;
   const Parser parser("machine " + machine.name);
   Block b;
   for (std::size_t i = 0; i < machine.heads.size(); ++i) {
     const config::AdditiveHead& h = machine.heads[i];
-    const std::string head = "heads[" + std::to_string(i) + "] (" + h.name + ")";
+    const std::string key = "heads[" + std::to_string(i) + "]";
+    const std::string head = key + " (" + h.name + ")";
     for (bool on : {true, false}) {
       const std::string& code = on ? h.codes.on : h.codes.off;
       bool ok = false;
@@ -64,9 +67,10 @@ void require_linuxcnc_codes(const config::Machine& machine) {
       } catch (const GcodeError&) {
       }
       if (!ok)
-        throw InputError(where + head + ".codes." + (on ? "on" : "off") + " '" + code +
-                         "' is not a LinuxCNC output code; expected M62/M64 P<n> to switch on and M63/M65 P<n> to "
-                         "switch off (printer codes such as M104 are rejected by LinuxCNC)");
+        return PostingProblem{key + ".codes." + (on ? "on" : "off"),
+                              head + ".codes." + (on ? "on" : "off") + " '" + code +
+                                  "' is not a LinuxCNC output code; expected M62/M64 P<n> to switch on and M63/M65 P<n> to "
+                                  "switch off (printer codes such as M104 are rejected by LinuxCNC)"};
     }
     if (h.codes.power_template) {
       std::string code = *h.codes.power_template;
@@ -79,8 +83,8 @@ void require_linuxcnc_codes(const config::Machine& machine) {
       } catch (const GcodeError&) {
       }
       if (!ok)
-        throw InputError(where + head + ".codes.power '" + *h.codes.power_template +
-                         "' is not a LinuxCNC analog output code; expected M68 E<n> Q{power} (or M67)");
+        return PostingProblem{key + ".codes.power", head + ".codes.power '" + *h.codes.power_template +
+                                                        "' is not a LinuxCNC analog output code; expected M68 E<n> Q{power} (or M67)"};
     }
   }
   const config::MCodes& c = machine.gcode.m_codes;
@@ -99,10 +103,20 @@ void require_linuxcnc_codes(const config::Machine& machine) {
       expected += (expected.empty() ? "M" : " or M") + std::to_string(allowed);
     }
     if (!ok)
-      throw InputError(where + "gcode.m_codes." + name + " " + *entry.first +
-                       " is not the code LinuxCNC runs for it; expected " + expected +
-                       " (or write this machine's programs in the fanuc dialect)");
+      return PostingProblem{std::string("gcode.m_codes.") + name,
+                            std::string("gcode.m_codes.") + name + " " + *entry.first +
+                                " is not the code LinuxCNC runs for it; expected " + expected +
+                                " (or write this machine's programs in the fanuc dialect)"};
   }
+  return std::nullopt;
+}
+
+namespace {
+
+/// The RS274NGC dialect writes only codes LinuxCNC runs. Throws InputError naming the key.
+void require_linuxcnc_codes(const config::Machine& machine) {
+  if (const auto problem = posting_problem(machine, Dialect::Rs274ngc))
+    throw InputError("machine '" + machine.name + "' (rs274ngc dialect): " + problem->message);
 }
 
 // ------------------------------------------------------------------ the writer
@@ -575,6 +589,18 @@ std::string write_action(const ActionProgram& action, const config::Machine& mac
 std::string write_program(const std::vector<ActionProgram>& actions, const config::Machine& machine,
                           const PostOptions& options) {
   return post_program(actions, machine, options).text();
+}
+
+config::Machine parse_postable_machine(std::string_view yaml_text, const std::string& file_name) {
+  config::Machine machine = config::parse_machine(yaml_text, file_name);
+  if (const auto problem = posting_problem(machine, machine.gcode.dialect))
+    throw config::MachineFileError(
+        {config::diagnostic_at(yaml_text, file_name, problem->key, "in the rs274ngc dialect (gcode.dialect), " + problem->message)});
+  return machine;
+}
+
+config::Machine load_postable_machine(const std::filesystem::path& path) {
+  return parse_postable_machine(config::read_machine_text(path), path.string());
 }
 
 std::string program_extension(config::Dialect dialect) { return dialect == Dialect::Fanuc ? ".nc" : ".ngc"; }

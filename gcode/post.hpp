@@ -66,6 +66,21 @@ std::string write_action(const ActionProgram& action, const config::Machine& mac
 /// ".ngc" for rs274ngc, ".nc" for fanuc.
 std::string program_extension(config::Dialect dialect);
 
+/// A code the machine file gives that `dialect`'s controller does not run (the RS274NGC
+/// dialect writes only codes LinuxCNC runs): the key in the machine file
+/// ("gcode.m_codes.spindle_cw", "heads[0].codes.on") and what is wrong and expected.
+struct PostingProblem {
+  std::string key;
+  std::string message;
+};
+std::optional<PostingProblem> posting_problem(const config::Machine& machine, config::Dialect dialect);
+
+/// config::parse_machine, then posting_problem for the machine's own dialect: a machine
+/// file whose programs could never be posted is refused when it is loaded, with the
+/// place of the key (MachineFileError, exit 3), not after planning.
+config::Machine parse_postable_machine(std::string_view yaml_text, const std::string& file_name);
+config::Machine load_postable_machine(const std::filesystem::path& path);
+
 struct ProgramFiles {
   std::filesystem::path program;               ///< DIR/NAME.ext: every action
   std::vector<std::filesystem::path> actions;  ///< DIR/NAME-action-NN.ext, one per action

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <regex>
@@ -275,6 +276,45 @@ TEST(PostRefusals, PrinterCodesAreNotWrittenForLinuxCnc) {
     EXPECT_NE(std::string(e.what()).find("gcode.m_codes.spindle_cw M203 is not the code LinuxCNC runs for it"),
               std::string::npos)
         << e.what();
+  }
+}
+
+// A machine file whose programs could never be posted is refused when it is loaded, at
+// the key's line and column, not after planning has run.
+TEST(PostRefusals, AMachineFileThatCannotPostIsRefusedAtLoadAtItsKey) {
+  std::string text = hybridctl::config::read_machine_text(std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/multitask-b-axis.yaml");
+  EXPECT_NO_THROW(parse_postable_machine(text, "multitask-b-axis.yaml")) << "the fanuc dialect runs M203";
+  const auto dialect = text.find("dialect: fanuc");
+  ASSERT_NE(dialect, std::string::npos);
+  text.replace(dialect, 14, "dialect: rs274ngc");
+  // The line and column of the spindle code's value in the file.
+  const auto value = text.find("M203");
+  const int line = 1 + int(std::count(text.begin(), text.begin() + std::ptrdiff_t(value), '\n'));
+  const int column = int(value - text.rfind('\n', value));
+  try {
+    parse_postable_machine(text, "b-axis-for-linuxcnc.yaml");
+    FAIL() << "loaded";
+  } catch (const hybridctl::config::MachineFileError& e) {
+    ASSERT_EQ(e.diagnostics().size(), 1u);
+    const auto& d = e.diagnostics()[0];
+    EXPECT_EQ(d.file, "b-axis-for-linuxcnc.yaml");
+    EXPECT_EQ(d.line, line);
+    EXPECT_EQ(d.column, column);
+    EXPECT_NE(d.message.find("gcode.m_codes.spindle_cw M203 is not the code LinuxCNC runs for it; expected M3"), std::string::npos)
+        << d.message;
+  }
+  // A head's code: at the head's own key, in a flow mapping.
+  std::string head = hybridctl::config::read_machine_text(std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/hybrid-3axis.yaml");
+  const auto on = head.find("M64 P0");
+  ASSERT_NE(on, std::string::npos);
+  head.replace(on, 6, "M104 S200");
+  try {
+    parse_postable_machine(head, "printer-codes.yaml");
+    FAIL() << "loaded";
+  } catch (const hybridctl::config::MachineFileError& e) {
+    const auto& d = e.diagnostics()[0];
+    EXPECT_EQ(d.line, 1 + int(std::count(head.begin(), head.begin() + std::ptrdiff_t(on), '\n')));
+    EXPECT_NE(d.message.find(".codes.on 'M104 S200' is not a LinuxCNC output code"), std::string::npos) << d.message;
   }
 }
 
