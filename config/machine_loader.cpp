@@ -12,6 +12,7 @@
 #include <cerrno>
 #include <sstream>
 #include <system_error>
+#include <vector>
 
 #include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
@@ -129,10 +130,15 @@ Machine load_machine(const std::filesystem::path& path) { return parse_machine(r
 
 Diagnostic diagnostic_at(std::string_view yaml_text, const std::string& file_name, std::string_view key_path, std::string message) {
   Diagnostic d{file_name, 0, 0, std::move(message)};
+  auto place = [&d](const YAML::Mark& m) {
+    d.line = m.line + 1;
+    d.column = m.column + 1;
+  };
   try {
-    YAML::Node node = YAML::Load(std::string(yaml_text));
+    const YAML::Node root = YAML::Load(std::string(yaml_text));
+    std::vector<YAML::Node> path{root};  // Node's operator= writes through: keep each step
     std::size_t at = 0;
-    while (at < key_path.size() && node.IsDefined()) {
+    while (at < key_path.size()) {
       const std::size_t end = std::min(key_path.find('.', at), key_path.size());
       std::string_view part = key_path.substr(at, end - at);
       at = end + 1;
@@ -141,18 +147,24 @@ Diagnostic diagnostic_at(std::string_view yaml_text, const std::string& file_nam
         index = std::stoul(std::string(part.substr(open + 1)));
         part = part.substr(0, open);
       }
-      // Node's operator= writes into the node it refers to: reset() moves the reference.
-      YAML::Node next;
-      next.reset(node.IsMap() ? node[std::string(part)] : YAML::Node(YAML::NodeType::Undefined));
-      if (next.IsDefined() && index) {
-        YAML::Node element;
-        element.reset(next.IsSequence() && *index < next.size() ? next[*index] : YAML::Node(YAML::NodeType::Undefined));
-        next.reset(element);
+      const YAML::Node node = path.back();  // a handle of its own: push_back moves the vector
+      if (!node.IsMap()) break;
+      bool found = false;
+      for (const auto& entry : node) {
+        if (!entry.first.IsScalar() || entry.first.Scalar() != part) continue;
+        place(entry.first.Mark());  // the key: where a defaulted value below it belongs
+        path.push_back(entry.second);
+        found = true;
+        break;
       }
-      if (!next.IsDefined()) break;
-      node.reset(next);
-      d.line = node.Mark().line + 1;
-      d.column = node.Mark().column + 1;
+      if (!found) break;
+      if (index) {
+        const YAML::Node sequence = path.back();
+        if (!sequence.IsSequence() || *index >= sequence.size()) break;
+        path.push_back(sequence[*index]);
+        place(path.back().Mark());
+      }
+      if (at >= key_path.size()) place(path.back().Mark());  // the value itself
     }
   } catch (const std::exception&) {  // a file that parsed once parses again; if not, the file as a whole
   }

@@ -115,3 +115,23 @@ TEST(HeadToolNumber, MayNotRepeatAnotherHeads) {
 }
 
 }  // namespace
+
+namespace {
+
+// A problem found after loading (a code the dialect's controller does not run) is placed at
+// its key: the value's line and column; for a key the file leaves to its default, the
+// deepest key of the path the file writes; for a path the file has none of, the file.
+TEST(MachineKeyPlaces, AKeyPathIsPlacedAtItsValueOrItsDeepestWrittenParent) {
+  using hybridctl::config::diagnostic_at;
+  const std::string yaml = kBase + "gcode:\n  m_codes:\n    spindle_cw: M203\n";  // lines 13-15
+  const Diagnostic value = diagnostic_at(yaml, "m.yaml", "gcode.m_codes.spindle_cw", "what");
+  EXPECT_EQ(value.str(), "m.yaml:15:17: what");
+  const Diagnostic defaulted = diagnostic_at(yaml, "m.yaml", "gcode.m_codes.spindle_ccw", "what");
+  EXPECT_EQ(defaulted.line, 14) << "the m_codes mapping, which leaves spindle_ccw to its default";
+  const Diagnostic head = diagnostic_at(yaml, "m.yaml", "heads[1].bead", "what");
+  EXPECT_EQ(head.line, 8);
+  EXPECT_EQ(diagnostic_at(yaml, "m.yaml", "heads[7].codes.on", "what").line, 6) << "no 8th head: the heads sequence";
+  EXPECT_EQ(diagnostic_at(yaml, "m.yaml", "coolant.pressure", "what").str(), "m.yaml: what");
+}
+
+}  // namespace
