@@ -3,6 +3,8 @@
 // and no output file left behind when something fails.
 
 #include <gtest/gtest.h>
+
+#include <algorithm>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -138,6 +140,24 @@ TEST_F(Cli, MachineCheckAcceptsTheExamplesAndPointsAtEveryProblem) {
   const Outcome r = run({"machine", "check", bad.string()});
   EXPECT_EQ(r.exit_code, 3);
   EXPECT_NE(r.err.find(bad.string() + ":6:1:"), std::string::npos) << r.err;
+}
+
+// The mill-turn's file told to write for LinuxCNC: its spindle code M203 is not LinuxCNC's.
+// `plan` refuses the file before planning (exit 3), at the code's line, and writes nothing.
+TEST_F(Cli, AMachineFileThatCannotPostIsRefusedBeforePlanningAtItsLine) {
+  std::string text = slurp(std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/multitask-b-axis.yaml");
+  text.replace(text.find("dialect: fanuc"), 14, "dialect: rs274ngc");
+  const int line = 1 + int(std::count(text.begin(), text.begin() + std::ptrdiff_t(text.find("M203")), '\n'));
+  const fs::path machine = write("b-axis-for-linuxcnc.yaml", text);
+  const Outcome planned = run({"plan", std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/flanged-hub.stl", "--machine",
+                               machine.string(), "-o", (dir_ / "plan").string()});
+  EXPECT_EQ(planned.exit_code, 3) << planned.err;
+  EXPECT_NE(planned.err.find(machine.string() + ":" + std::to_string(line) + ":"), std::string::npos) << planned.err;
+  EXPECT_NE(planned.err.find("spindle_cw M203 is not the code LinuxCNC runs"), std::string::npos) << planned.err;
+  EXPECT_FALSE(fs::exists(dir_ / "plan"));
+  const Outcome checked = run({"machine", "check", machine.string()});
+  EXPECT_EQ(checked.exit_code, 3);
+  EXPECT_NE(checked.err.find(machine.string() + ":" + std::to_string(line) + ":"), std::string::npos) << checked.err;
 }
 
 }  // namespace
