@@ -30,6 +30,14 @@ namespace hybridctl::toolpaths::pocket {
 struct FinishLevel;
 struct FinishRun;
 
+// A wall finishing pass as it is cut: in air to the wall along the lead-in (a quarter
+// circle tangent to the wall, or a straight move), round the wall, out along the lead-out.
+struct FinishPass {
+  std::vector<Point2> lead_in;   // from where the tool comes down, up to (not including) body's first
+  std::vector<Point2> body;      // on the wall
+  std::vector<Point2> lead_out;  // after body's last, to where the tool leaves
+};
+
 inline constexpr double kInf = std::numeric_limits<double>::infinity();
 // Heights are compared with this slack (mm): a tool tip this close above a voxel centre
 // still counts as touching it.
@@ -140,10 +148,10 @@ class PocketBuilder {
   void finish_walls(const TipKeepOut& keep_out, int k, int k_above, double z);
   // What those passes must keep clear of; nothing when no wall there is this level's.
   std::optional<FinishLevel> finish_level(const TipKeepOut& keep_out, int k, int k_above, double z) const;
-  std::optional<Point2> finish_lead(const FinishLevel& f, Point2 p, Point2 t, bool in) const;
-  // A run with its lead-in and lead-out points, or nothing when it has none.
-  std::optional<std::vector<Point2>> finish_pass(const FinishLevel& f, const FinishRun& run, Point2 from) const;
-  void cut_finish_pass(const FinishLevel& f, const std::vector<Point2>& pts);
+  std::optional<std::vector<Point2>> finish_lead(const FinishLevel& f, Point2 p, Point2 t, bool in) const;
+  // A run with its lead-in and lead-out, or nothing when it has none.
+  std::optional<FinishPass> finish_pass(const FinishLevel& f, const FinishRun& run, Point2 from) const;
+  void cut_finish_pass(const FinishLevel& f, const FinishPass& pass);
   // contact_height at any point (mm, work frame), not only at a cell's centre: exact for
   // the voxels' column tops (`tops`: tops_, or another set's over tops_box_).
   double contact_height_at(Point2 p, Part part) const { return contact_height_at(p, part, tops_); }

@@ -20,6 +20,9 @@ namespace hybridctl::toolpaths::pocket {
 namespace {
 
 constexpr double kSqrtHalf = 0.70710678118654757;
+constexpr double kPi = 3.14159265358979323846;
+// How far a lead arc's chords may lie inside it (mm): half arc fitting's chord tolerance.
+constexpr double kLeadSagitta = 0.0005;
 
 double distance(Point2 a, Point2 b) { return std::hypot(b.x - a.x, b.y - a.y); }
 
@@ -387,40 +390,67 @@ std::optional<FinishLevel> PocketBuilder::finish_level(const TipKeepOut& keep_ou
   return f;
 }
 
-// From `p` on the contour, heading `t`, a point off it on the air side (the left: the
-// keep-out region is on the right), obliquely behind (lead-in) or ahead (lead-out) or
-// square to it, 1 to r/h + 3 voxels out, such that the straight move between them is safe;
-// for a lead-in, also where the tool comes straight down in air.
-std::optional<Point2> PocketBuilder::finish_lead(const FinishLevel& f, Point2 p, Point2 t, bool in) const {
+// The lead at `p` on the contour, heading `t`, on the air side (the left: the keep-out
+// region is on the right). First choice, a quarter circle tangent to the contour at p
+// whose centre is in air (so the whole circle keeps to the air side of the contour's
+// tangent there): the cutter comes onto the wall (lead-in) or leaves it (lead-out) along
+// the wall's own direction, without a mark where it meets it. Its radius is the cutter's,
+// else smaller, down to a voxel; its chords are at most 0.0005 mm inside the circle, so
+// that arc fitting makes it one G2/G3 (docs/toolpaths.md, "Arc fitting"). Every chord
+// must be a safe move at the level and, for a lead-in, the tool must come straight down
+// in air at its start. Else the straight lead: a point obliquely behind (lead-in) or ahead
+// (lead-out) or square to it, 1 to r/h + 3 voxels out.
+std::optional<std::vector<Point2>> PocketBuilder::finish_lead(const FinishLevel& f, Point2 p, Point2 t, bool in) const {
   const Point2 nrm{-t.y, t.x};
+  auto down_in_air = [&](Point2 a) { return !in || contact_height_at(a, Part::Whole) < f.z - kHeightSlack; };
+  for (const double radius : {f.r, 0.75 * f.r, 0.5 * f.r, 0.25 * f.r, h_}) {
+    if (radius < h_ - 1e-12) continue;
+    const Point2 c{p.x + radius * nrm.x, p.y + radius * nrm.y};
+    const double chord_angle = 2 * std::acos(std::max(-1.0, 1 - kLeadSagitta / radius));
+    const int chords = std::max(4, int(std::ceil((kPi / 2) / chord_angle)));
+    // The point at angle phi (0: p) along the circle, back (lead-in) or ahead (lead-out):
+    // p - c = -radius * nrm, turned by -phi or +phi.
+    auto at = [&](double phi) {
+      const double turn = in ? -phi : phi, cs = std::cos(turn), sn = std::sin(turn);
+      const Point2 v{-nrm.x, -nrm.y};
+      return Point2{c.x + radius * (v.x * cs - v.y * sn), c.y + radius * (v.x * sn + v.y * cs)};
+    };
+    std::vector<Point2> lead;
+    bool safe = true;
+    Point2 prev = p;
+    for (int j = 1; j <= chords && safe; ++j) {
+      const Point2 q = at((kPi / 2) * j / chords);
+      safe = !f.keep_out->contains(q) && f.segment_safe(prev, q);
+      lead.push_back(q);
+      prev = q;
+    }
+    if (!safe || !down_in_air(lead.back())) continue;
+    if (in) std::reverse(lead.begin(), lead.end());
+    return lead;
+  }
   const double s = in ? -1 : 1;
   const Point2 oblique{(nrm.x + s * t.x) * kSqrtHalf, (nrm.y + s * t.y) * kSqrtHalf};
   const int steps = int(std::ceil(f.r / h_)) + 3;
   for (int i = 1; i <= steps; ++i)
     for (const Point2 dir : {oblique, nrm}) {
       const Point2 a{p.x + i * h_ * dir.x, p.y + i * h_ * dir.y};
-      if (f.keep_out->contains(a) || !f.segment_safe(a, p)) continue;
-      if (in && !(contact_height_at(a, Part::Whole) < f.z - kHeightSlack)) continue;
-      return a;
+      if (f.keep_out->contains(a) || !f.segment_safe(a, p) || !down_in_air(a)) continue;
+      return std::vector<Point2>{a};
     }
   return std::nullopt;
 }
 
-// A run as it is cut: its lead-in point, the run (an open one from its first point that
-// leads in to its last that leads out; a closed one from the first of 24 points round it,
-// nearest `from` first, where both work, round to it again), its lead-out point.
-std::optional<std::vector<Point2>> PocketBuilder::finish_pass(const FinishLevel& f, const FinishRun& run,
-                                                             Point2 from) const {
-  auto with_leads = [&](const std::vector<Point2>& body) -> std::optional<std::vector<Point2>> {
+// A run as it is cut: its lead-in, the run (an open one from its first point that leads
+// in to its last that leads out; a closed one from the first of 24 points round it,
+// nearest `from` first, where both work, round to it again), its lead-out.
+std::optional<FinishPass> PocketBuilder::finish_pass(const FinishLevel& f, const FinishRun& run, Point2 from) const {
+  auto with_leads = [&](const std::vector<Point2>& body) -> std::optional<FinishPass> {
     const std::size_t m = body.size();
-    const std::optional<Point2> a = finish_lead(f, body[0], unit(body[0], body[1]), true);
+    std::optional<std::vector<Point2>> a = finish_lead(f, body[0], unit(body[0], body[1]), true);
     if (!a) return std::nullopt;
-    const std::optional<Point2> b = finish_lead(f, body[m - 1], unit(body[m - 2], body[m - 1]), false);
+    std::optional<std::vector<Point2>> b = finish_lead(f, body[m - 1], unit(body[m - 2], body[m - 1]), false);
     if (!b) return std::nullopt;
-    std::vector<Point2> out{*a};
-    out.insert(out.end(), body.begin(), body.end());
-    out.push_back(*b);
-    return out;
+    return FinishPass{std::move(*a), body, std::move(*b)};
   };
   if (run.closed) {
     std::vector<Point2> closed = run.points;
@@ -457,11 +487,12 @@ std::optional<std::vector<Point2>> PocketBuilder::finish_pass(const FinishLevel&
   return std::nullopt;
 }
 
-// Gets to the pass's lead-in point (a feed at the level from where the tool is when that is
+// Gets to the pass's lead-in (a feed at the level from where the tool is when that is
 // safe, else down from above in air), cuts it and takes what the cutter swept from the
-// material still there.
-void PocketBuilder::cut_finish_pass(const FinishLevel& f, const std::vector<Point2>& pts) {
-  const Point2 here{at_.x, at_.y}, a = pts.front();
+// material still there. The lead-in's last move and the lead-out's first carry the
+// comments: an arc is fitted to what follows a comment, never across one.
+void PocketBuilder::cut_finish_pass(const FinishLevel& f, const FinishPass& pass) {
+  const Point2 here{at_.x, at_.y}, a = pass.lead_in.front();
   std::vector<Point2> swept;
   if (at_level_ && std::abs(at_.z - f.z) <= kHeightSlack && f.segment_safe(here, a)) {
     move(MoveKind::Feed, {a.x, a.y, f.z}, tool_.feed, true, "link");
@@ -472,10 +503,14 @@ void PocketBuilder::cut_finish_pass(const FinishLevel& f, const std::vector<Poin
     move(MoveKind::Feed, {a.x, a.y, f.z}, tool_.plunge_feed, false, "plunge in air");
     at_level_ = true;
   }
-  for (std::size_t i = 1; i < pts.size(); ++i)
-    move(MoveKind::Feed, {pts[i].x, pts[i].y, f.z}, tool_.feed, true,
-         i == 1 ? "finish lead-in" : i + 1 == pts.size() ? "finish lead-out" : "");
-  swept.insert(swept.end(), pts.begin(), pts.end());
+  auto feed = [&](Point2 q, const char* comment) { move(MoveKind::Feed, {q.x, q.y, f.z}, tool_.feed, true, comment); };
+  for (std::size_t i = 1; i < pass.lead_in.size(); ++i) feed(pass.lead_in[i], i == 1 ? "finish lead-in arc" : "");
+  feed(pass.body.front(), "finish lead-in");
+  for (std::size_t i = 1; i < pass.body.size(); ++i) feed(pass.body[i], "");
+  for (std::size_t i = 0; i < pass.lead_out.size(); ++i) feed(pass.lead_out[i], i == 0 ? "finish lead-out" : "");
+  swept.insert(swept.end(), pass.lead_in.begin(), pass.lead_in.end());
+  swept.insert(swept.end(), pass.body.begin(), pass.body.end());
+  swept.insert(swept.end(), pass.lead_out.begin(), pass.lead_out.end());
   stamp_polyline(swept, f.z);
 }
 
@@ -500,13 +535,13 @@ void PocketBuilder::finish_walls(const TipKeepOut& keep_out, int k, int k_above,
     const FinishRun run = std::move(runs[pick]);
     runs.erase(runs.begin() + std::ptrdiff_t(pick));
     const double run_length = run.closed ? length_of(loop_from(run.points, 0)) : length_of(run.points);
-    const std::optional<std::vector<Point2>> pass = finish_pass(*f, run, here);
+    const std::optional<FinishPass> pass = finish_pass(*f, run, here);
     if (!pass) {
       ++finish_skipped_;
       finish_skipped_length_ += run_length;
       continue;
     }
-    const double cut_length = length_of(std::vector<Point2>(pass->begin() + 1, pass->end() - 1));
+    const double cut_length = length_of(pass->body);
     finish_skipped_length_ += std::max(0.0, run_length - cut_length);
     finish_length_ += cut_length;
     ++finish_passes_;
