@@ -540,6 +540,24 @@ TEST(PocketPath, WallFinishingPutsAFlatCuttersSideOnThePocketsRealWalls) {
     for (std::size_t i = 0; i + 1 < pass.size(); ++i) area += pass[i].x * pass[i + 1].y - pass[i + 1].x * pass[i].y;
     EXPECT_GT(area, 0);
   }
+  // Each pass comes onto the wall along a quarter circle tangent to it: the lead-in's last
+  // chord turns into the wall's direction by at most half a chord's angle (a straight lead
+  // meets it at 45 or 90 degrees).
+  int arc_leads = 0;
+  bool arc = false;
+  for (std::size_t i = 1; i + 1 < p.moves.size(); ++i) {
+    if (p.moves[i].comment == "finish lead-in arc") arc = true;
+    if (p.moves[i].comment != "finish lead-in") continue;
+    if (arc) {
+      ++arc_leads;
+      const Vec3 a = p.moves[i - 1].to, b = p.moves[i].to, c = p.moves[i + 1].to;
+      const double turn = std::abs(std::atan2((b.x - a.x) * (c.y - b.y) - (b.y - a.y) * (c.x - b.x),
+                                              (b.x - a.x) * (c.x - b.x) + (b.y - a.y) * (c.y - b.y)));
+      EXPECT_LT(turn * 180 / M_PI, 3.0) << "at (" << b.x << ", " << b.y << ")";
+    }
+    arc = false;
+  }
+  EXPECT_GT(arc_leads, 0);
   // What stays of the ROI on the voxels is no more than without the finishing.
   const Replay rq = replay(q, stock, design, tool);
   EXPECT_LE(geometry::intersect(rp.present, roi).voxel_count(), geometry::intersect(rq.present, roi).voxel_count());
