@@ -207,6 +207,8 @@ struct CuttingTool {
   double spindle_speed = 10000.0;       ///< rpm, > 0
   double feed = 1000.0;                 ///< mm/min, > 0
   double plunge_feed = 300.0;           ///< mm/min, > 0
+  /// mm/min of the finishing passes (walls, 3D faces), > 0; 0 in the model: not given (finishing_feed()).
+  double finish_feed = 0.0;
   double step_down = 0.0;               ///< mm, 0 < d <= flute_length; default 0.5 x diameter
   double step_over = 0.0;               ///< mm, 0 < s <= diameter; default 0.4 x diameter
   double cost_per_mm3 = 1.0;            ///< cost factor per mm³ removed, >= 0 (objective cost-factor)
@@ -221,6 +223,8 @@ struct CuttingTool {
   /// mm³/min in force: the machine file's removal_rate, else a full step-down and
   /// step-over at the feed.
   double volume_rate() const { return removal_rate > 0 ? removal_rate : step_down * step_over * feed; }
+  /// The finishing passes' feed in force: the machine file's finish_feed, else the feed.
+  double finishing_feed() const { return finish_feed > 0 ? finish_feed : feed; }
   bool offers(PrimitiveKind k) const {
     for (auto p : primitives)
       if (p == k) return true;

@@ -272,7 +272,7 @@ std::optional<std::size_t> MachineReader::read_tools(const Value& v) {
 void MachineReader::read_tool(const Value& v) {
   MapReader r(sink_, v,
               {"number", "name", "type", "diameter", "corner_radius", "flute_length", "shank", "holder",
-               "spindle_speed", "feed", "plunge_feed", "step_down", "step_over", "cost_per_mm3", "removal_rate", "wear", "primitives"});
+               "spindle_speed", "feed", "plunge_feed", "finish_feed", "step_down", "step_over", "cost_per_mm3", "removal_rate", "wear", "primitives"});
   if (!r.ok()) return;
   const std::size_t before = sink_.count();
   CuttingTool t;
@@ -292,6 +292,7 @@ void MachineReader::read_tool(const Value& v) {
   number(r, "spindle_speed", kSpindleSpeed, Bound::Positive, t.spindle_speed);
   number(r, "feed", kFeed, Bound::Positive, t.feed);
   number(r, "plunge_feed", kFeed, Bound::Positive, t.plunge_feed);
+  number(r, "finish_feed", kFeed, Bound::Positive, t.finish_feed);
   read_steps(r, flute_length.has_value(), diameter, t);
   number(r, "cost_per_mm3", kCostFactor, Bound::NonNegative, t.cost_per_mm3);
   number(r, "removal_rate", kVolumeRate, Bound::Positive, t.removal_rate);

@@ -363,6 +363,7 @@ std::optional<FinishLevel> PocketBuilder::finish_level(const TipKeepOut& keep_ou
     kept &= d;
     kept_design |= kept;
   }
+  if (roi_here.empty() || kept_design.empty()) return std::nullopt;  // nothing this level removes, or no wall
   f.near = grow_by_disc(roi_here, f.r / h_ + 2);
   f.near &= grow_by_disc(kept_design, f.r / h_ + 2);
   if (f.near.empty()) return std::nullopt;
@@ -503,7 +504,9 @@ void PocketBuilder::cut_finish_pass(const FinishLevel& f, const FinishPass& pass
     move(MoveKind::Feed, {a.x, a.y, f.z}, tool_.plunge_feed, false, "plunge in air");
     at_level_ = true;
   }
-  auto feed = [&](Point2 q, const char* comment) { move(MoveKind::Feed, {q.x, q.y, f.z}, tool_.feed, true, comment); };
+  auto feed = [&](Point2 q, const char* comment) {
+    move(MoveKind::Feed, {q.x, q.y, f.z}, tool_.finishing_feed(), true, comment);
+  };
   for (std::size_t i = 1; i < pass.lead_in.size(); ++i) feed(pass.lead_in[i], i == 1 ? "finish lead-in arc" : "");
   feed(pass.body.front(), "finish lead-in");
   for (std::size_t i = 1; i < pass.body.size(); ++i) feed(pass.body[i], "");

@@ -248,7 +248,8 @@ void PocketBuilder::cut_surface_pass(const std::vector<Vec3>& pts, const std::ve
   std::vector<Vec3> swept;
   if (!link.empty()) {
     // Over the surface from where the last pass ended: the link's own drop-cutter path.
-    for (std::size_t k = 1; k < link.size(); ++k) move(MoveKind::Feed, link[k], tool_.feed, true, k == 1 ? "link" : "");
+    for (std::size_t k = 1; k < link.size(); ++k)
+      move(MoveKind::Feed, link[k], tool_.finishing_feed(), true, k == 1 ? "link" : "");
     swept = link;
   } else {
     retract();
@@ -256,7 +257,7 @@ void PocketBuilder::cut_surface_pass(const std::vector<Vec3>& pts, const std::ve
     move(MoveKind::Feed, s, tool_.plunge_feed, true, "down to the surface");
     at_level_ = true;
   }
-  for (std::size_t k = 1; k < pts.size(); ++k) move(MoveKind::Feed, pts[k], tool_.feed, true);
+  for (std::size_t k = 1; k < pts.size(); ++k) move(MoveKind::Feed, pts[k], tool_.finishing_feed(), true);
   swept.insert(swept.end(), pts.begin(), pts.end());
   stamp_surface_pass(swept);
   ++surface_passes_;

@@ -201,7 +201,7 @@ TEST(MachineDefaults, ToolDefaultsFollowTheTypeAndDiameter) {
       "envelope: {X: {travel: [0, 100]}, Y: {travel: [0, 100]}, Z: {travel: [0, 200]}}\n"
       "tools:\n"
       "  - {number: 5, type: ball, diameter: 8}\n"
-      "  - {number: 6, type: flat, diameter: 4, name: small}\n"
+      "  - {number: 6, type: flat, diameter: 4, name: small, finish_feed: 450}\n"
       "setups: [{name: s}]\n",
       "t.yaml");
   const CuttingTool& ball = *m.find_tool(5);
@@ -214,11 +214,13 @@ TEST(MachineDefaults, ToolDefaultsFollowTheTypeAndDiameter) {
   EXPECT_DOUBLE_EQ(ball.step_over, 3.2);
   EXPECT_EQ(ball.feed, 1000.0);
   EXPECT_EQ(ball.plunge_feed, 300.0);
+  EXPECT_EQ(ball.finishing_feed(), 1000.0) << "the feed, when no finish_feed is given";
   EXPECT_EQ(ball.cost_per_mm3, 1.0);
   EXPECT_TRUE(ball.offers(PrimitiveKind::SmMax));
   EXPECT_TRUE(ball.offers(PrimitiveKind::SmCons));
   EXPECT_EQ(m.find_tool(6)->name, "small");
   EXPECT_EQ(m.find_tool(6)->corner_radius, 0.0);
+  EXPECT_EQ(m.find_tool(6)->finishing_feed(), 450.0);
 }
 
 TEST(MachineSummary, NamesEverySection) {

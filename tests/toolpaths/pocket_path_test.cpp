@@ -501,7 +501,8 @@ TEST(PocketPath, WallFinishingPutsAFlatCuttersSideOnThePocketsRealWalls) {
   const Solid stock = box(outer);
   const Solid design = geometry::voxelize(geometry::TriangleMesh{*mesh}, kLattice, "pocketed block");
   const Solid roi = geometry::subtract(stock, design);
-  const auto tool = flat_4mm();
+  auto tool = flat_4mm();
+  tool.finish_feed = tool.feed / 2;
   const double r = tool.diameter / 2;
   PocketOptions on;
   on.design = mesh;
@@ -548,6 +549,7 @@ TEST(PocketPath, WallFinishingPutsAFlatCuttersSideOnThePocketsRealWalls) {
   for (std::size_t i = 1; i + 1 < p.moves.size(); ++i) {
     if (p.moves[i].comment == "finish lead-in arc") arc = true;
     if (p.moves[i].comment != "finish lead-in") continue;
+    EXPECT_EQ(p.moves[i].feed, tool.finish_feed) << "the finishing passes run at the tool's finishing feed";
     if (arc) {
       ++arc_leads;
       const Vec3 a = p.moves[i - 1].to, b = p.moves[i].to, c = p.moves[i + 1].to;
