@@ -260,7 +260,10 @@ class Host {
       recorded.resume = resume;
       recorded.wait_for_controller_s = o_.wait_for_controller_s;
       result = run_recorded_job(recorded, o_.yes);
-    } catch (const drivers::TransportError& e) {
+    } catch (const drivers::TransportError& e) {  // the controller unreachable: exit 6, the job stays bound
+      conn_.retrying([&](Database& db) { cell::stopped_on_machine(db, job.job, name_, e.what()); });
+      throw;
+    } catch (const InputError& e) {  // the controller holds another program, ...: exit 3, the job stays bound
       conn_.retrying([&](Database& db) { cell::stopped_on_machine(db, job.job, name_, e.what()); });
       throw;
     }
