@@ -22,7 +22,6 @@
 #include <utility>
 #include <vector>
 
-#include "protocol/chunk.hpp"
 
 extern char** environ;
 
@@ -96,21 +95,6 @@ inline ChildProcess start_simulator(const std::vector<std::string>& extra_args, 
   if (at == std::string::npos) throw std::runtime_error("the simulator printed no '" + key + "' line: " + out);
   child.port = std::stoi(out.substr(at + key.size()));
   return child;
-}
-
-// A program of ~28-byte feed moves inside the example machine's travel, titled `title`:
-// a distinct title makes a distinct program (its identity), so every iteration of a
-// stream is a new program from line 1.
-inline std::vector<std::string> feed_moves_program(int moves, const std::string& title) {
-  std::string p = "(" + title + ")\nG21 G90 G17\nG54\nT1 M6\nS8000 M3\nG0 X0 Y0 Z20\n";
-  char line[64];
-  for (int i = 0; i < moves; ++i) {
-    std::snprintf(line, sizeof line, "G1 X%.3f Y%.3f Z20 F1200\n", 10 + (i * 7919LL % 40000) / 1000.0,
-                  10 + (i * 104729LL % 20000) / 1000.0);
-    p += line;
-  }
-  p += "M5\nM2\n";
-  return protocol::program_lines(p);
 }
 
 }  // namespace hybridctl::bench

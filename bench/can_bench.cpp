@@ -27,6 +27,7 @@
 
 #include "bench/bench_main.hpp"
 #include "bench/bench_process.hpp"
+#include "tests/drivers/feed_moves_program.hpp"
 #include "drivers/journal.hpp"
 #include "protocol/chunk.hpp"
 #include "protocol/messages.hpp"
@@ -104,7 +105,7 @@ void BM_RawBusFrames(benchmark::State& state) {
   state.counters["vs_theory"] = g_raw_rate / theoretical_payload_rate();
 }
 
-std::vector<std::string> program(int moves, int run) { return bench::feed_moves_program(moves, "can_bench run " + std::to_string(run)); }
+std::vector<std::string> program(int moves, int run) { return hybridctl::testing::feed_moves_program(moves, "can_bench run " + std::to_string(run)); }
 
 // Where the stream's time goes: the seconds spent inside each kind of transport call.
 class TimedTransport final : public drivers::Transport {

@@ -19,6 +19,7 @@
 #include "bench/bench_cell.hpp"
 #include "bench/bench_main.hpp"
 #include "bench/bench_process.hpp"
+#include "tests/drivers/feed_moves_program.hpp"
 #include "cell/database.hpp"
 #include "cell/stream_journal.hpp"
 #include "cell/streams.hpp"
@@ -49,7 +50,7 @@ cell::testing::PostgresServer& server() {
   return s;
 }
 
-std::vector<std::string> program(int moves, int run) { return bench::feed_moves_program(moves, "cell_stream_bench run " + std::to_string(run)); }
+std::vector<std::string> program(int moves, int run) { return hybridctl::testing::feed_moves_program(moves, "cell_stream_bench run " + std::to_string(run)); }
 
 // A planned job bound to the machine with `lines` as its program, as the host binds one.
 std::int64_t bound_job(cell::Database& db, const std::vector<std::string>& lines) {

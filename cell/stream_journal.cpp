@@ -36,6 +36,7 @@ void StreamJournal::acknowledged(std::uint32_t chunk, std::uint32_t through_line
   progress_.executed_line = executed_line;
   std::lock_guard lock(mutex_);
   pending_.progress = progress_;
+  changed_ = true;
 }
 
 void StreamJournal::executed(std::uint32_t line) {
@@ -43,11 +44,13 @@ void StreamJournal::executed(std::uint32_t line) {
   progress_.executed_line = line;
   std::lock_guard lock(mutex_);
   pending_.progress = progress_;
+  changed_ = true;
 }
 
 void StreamJournal::note(const std::string& event) {
   std::lock_guard lock(mutex_);
   pending_.events.emplace_back("note", event);
+  changed_ = true;
 }
 
 void StreamJournal::completed(std::uint32_t executed_line) {
@@ -107,8 +110,10 @@ void StreamJournal::run_writer() {
   while (!stop_) {
     wake_.wait_for(lock, std::chrono::duration<double>(sync_period_s), [this] { return stop_; });
     if (stop_) break;
+    // Nothing new is written a quarter lease apart: the write renews the lease.
+    if (!changed_ && seconds_since_written() < where_.lease_s / 4) continue;
     lock.unlock();
-    write_pending();  // also when nothing changed: the write renews the lease
+    write_pending();
     lock.lock();
   }
 }
@@ -120,6 +125,7 @@ bool StreamJournal::write_pending() {
   {
     std::lock_guard lock(mutex_);
     p = pending_;
+    changed_ = false;
   }
   try {
     if (!db_) db_ = std::make_unique<Database>(where_.uri);
@@ -152,6 +158,7 @@ bool StreamJournal::write_pending() {
   } catch (const DatabaseError& e) {
     if (e.connection_lost()) db_.reset();
     std::lock_guard lock(mutex_);
+    changed_ = true;  // written again at the next period
     if (database_error_.empty() && where_.log)
       where_.log(std::string("database lost (") + e.what() + "): the stream goes on while the lease lasts; its record waits");
     database_error_ = e.what();

@@ -1,8 +1,9 @@
 #pragma once
 // A bound job's record in the cell's database (docs/cell.md, "Machine hosts"): what the
 // streamer acknowledges is written to the job's cell_streams row, with its notes as
-// events, by a thread of its own at most `sync_period_s` later, in one transaction that
-// first renews the host's lease on the machine; a host whose lease another host took
+// events, by a thread of its own at most `sync_period_s` later (and a quarter of the lease
+// apart when nothing changes), in one transaction that first renews the host's lease on
+// the machine; a host whose lease another host took
 // writes nothing more and stops sending (writable() turns false). The end of the job, a
 // controller loss and a hold are written at once. The database unreachable for longer
 // than half the lease also stops the stream: by then another host may take the machine.
@@ -72,6 +73,7 @@ class StreamJournal : public drivers::JobRecord {
   drivers::JournalProgress progress_;  // the streamer's thread's view
   mutable std::mutex mutex_;           // pending_, stop_, database_error_
   Pending pending_;
+  bool changed_ = false;  // pending_ holds what is not yet written
   bool stop_ = false;
   std::condition_variable wake_;
   std::mutex db_mutex_;  // the connection, used by one thread at a time

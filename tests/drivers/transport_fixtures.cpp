@@ -1,5 +1,7 @@
 #include "transport_fixtures.hpp"
 
+#include "feed_moves_program.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -80,18 +82,7 @@ protocol::Status wait_for_state(drivers::Transport& transport, protocol::Control
   return s;
 }
 
-std::vector<std::string> program_of(int moves) {
-  std::string p = "G21 G90 G17\nG54\nT1 M6\nS8000 M3\nG0 X0 Y0 Z20\n";
-  char line[64];
-  for (int i = 0; i < moves; ++i) {
-    // "G1 X12.345 Y23.456 Z20 F1200": about 28 bytes, inside the example machine's travel.
-    std::snprintf(line, sizeof line, "G1 X%.3f Y%.3f Z20 F1200\n", 10 + (i * 7919LL % 40000) / 1000.0,
-                  10 + (i * 104729LL % 20000) / 1000.0);
-    p += line;
-  }
-  p += "M5\nM2\n";
-  return protocol::program_lines(p);
-}
+std::vector<std::string> program_of(int moves) { return hybridctl::testing::feed_moves_program(moves); }
 
 std::string scratch_dir(const std::string& name) {
   const auto dir = std::filesystem::path(HYBRIDCTL_BINARY_DIR) / "test-scratch" / "drivers" / name;
