@@ -29,8 +29,8 @@ struct CandidateRun {
   // A proven plan: each action's cycle time in minutes as `gcode check` estimates it from
   // the action's own program (0 for one that makes no G-code); empty otherwise.
   std::vector<double> action_minutes;
-  // A proven plan: the part it makes against the design's real surface (none: the design
-  // has no real surface, as a design made on voxels).
+  // The part it makes against the design's real surface, when executed to its end (none:
+  // the design has no real surface, as a design made on voxels, or the plan failed before).
   std::optional<ExactDeviation> exact;
   bool proven() const { return reasons.empty(); }
 };

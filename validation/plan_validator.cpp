@@ -188,9 +188,15 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
         } else if (run.proven() || std::all_of(run.reasons.begin(), run.reasons.end(), [](const plan::RejectionReason& r) {
                      return r.kind == "exact_excess" || r.kind == "exact_gouge";
                    })) {
-          const double off = std::max(run.exact->excess.mm, run.exact->gouge.mm);
-          state->closest_mm = state->exact_failures == 0 ? off : std::min(state->closest_mm, off);
-          ++state->exact_failures;
+          // A face left as deposited is the deposit's, which the planner learns and passes
+          // over from then on (planner/pipeline/deposited_faces.hpp); a machined face beyond
+          // the tolerance says the finishing falls short, which every later candidate shares.
+          const plan::ExactPlace& worst = run.exact->excess.mm >= run.exact->gouge.mm ? run.exact->excess : run.exact->gouge;
+          if (!worst.as_deposited) {
+            const double off = std::max(run.exact->excess.mm, run.exact->gouge.mm);
+            state->closest_mm = state->exact_failures == 0 ? off : std::min(state->closest_mm, off);
+            ++state->exact_failures;
+          }
           if (std::optional<ExactFailure> f = failure_of(file, candidate, *run.exact)) state->exact_failed.push_back(*f);
         }
       }
@@ -209,6 +215,7 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
       out.missing_after_last_addition = run.missing_after_last_addition;
       out.as_built = std::move(run.as_built);
       out.reasons = std::move(run.reasons);
+      out.exact = std::move(run.exact);
       return out;
     } catch (const InputError& e) {
       // The plan cannot be written for this machine (a move beyond its envelope, ...): it

@@ -19,7 +19,18 @@ plan::PlanFilePlan candidate_plan(const PlanningResult& r, const Plan& plan) {
 CandidateCheck learn_from_run(const PlanningResult& r, const Plan& plan, const plan::PlanFile& file, plan::CandidateRun run,
                               std::optional<geometry::Solid>& core) {
   if (run.proven()) return CandidateCheck{};
-  if (!run.as_built) return CandidateCheck{std::move(run.reasons)};
+  // Faces left beyond the tolerance as deposited: the deposit's own, wherever the plan stands.
+  std::vector<DepositedFace> faces;
+  if (run.exact)
+    for (const plan::ExactPlace* place : {&run.exact->excess, &run.exact->gouge})
+      if (place->as_deposited && place->at && place->mm > run.exact->tolerance && place->action >= 1 &&
+          std::size_t(place->action) <= plan.steps.size())
+        faces.push_back({plan.steps[std::size_t(place->action - 1)].primitive, *place->at, place->mm});
+  if (!run.as_built) {
+    CandidateCheck check{std::move(run.reasons)};
+    check.faces = std::move(faces);
+    return check;
+  }
   const geometry::Solid& built = *run.as_built;
   const std::size_t executed = run.executed;
   std::vector<Shortfall> shortfalls = find_shortfalls(r.problem, r.atoms, plan, executed, built);
@@ -29,7 +40,9 @@ CandidateCheck learn_from_run(const PlanningResult& r, const Plan& plan, const p
   }
   if (shortfalls.empty()) shortfalls = find_skipped_layer_shortfalls(r.problem, r.atoms, plan, executed, built, run.reasons);
   if (shortfalls.empty()) shortfalls = find_spills(r.problem, r.atoms, plan, executed, built, run.reasons);
-  return CandidateCheck{std::move(run.reasons), std::move(shortfalls)};
+  CandidateCheck check{std::move(run.reasons), std::move(shortfalls)};
+  check.faces = std::move(faces);
+  return check;
 }
 
 void validate_by_execution(PlanningOptions& options, plan::CandidateExecutor execute, const std::string& machine_name) {

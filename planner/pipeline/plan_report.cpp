@@ -209,6 +209,28 @@ json stock_starts_json(const PlanningResult& r) {
   return out;
 }
 
+// The rule of faces left as deposited: per deposit held to it, why and on how many atoms;
+// the faces executed candidates showed; the plans passed over for it.
+json faces_json(const PlanningResult& r) {
+  json deposits = json::array();
+  for (std::size_t i = 0; i < r.faces.tight.size(); ++i) {
+    if (r.faces.why[i].empty()) continue;
+    std::size_t atoms = 0;
+    for (const std::uint64_t w : r.faces.tight[i].words()) atoms += std::size_t(__builtin_popcountll(w));
+    deposits.push_back({{"primitive", r.primitives[i].name},
+                        {"atoms", atoms},
+                        {"learned_atoms", r.faces.learned_atoms[i].size()},
+                        {"why", r.faces.why[i]}});
+  }
+  json learned = json::array();
+  for (const DepositedFace& f : r.faces.learned)
+    learned.push_back({{"primitive", r.primitives[std::size_t(f.primitive)].name}, {"at", {f.at.x, f.at.y, f.at.z}}, {"mm", f.mm}});
+  return {{"deposits", deposits},
+          {"learned", learned},
+          {"passed_over", r.faces.passed_over},
+          {"first", r.faces.first_passed.empty() ? json(nullptr) : json(r.faces.first_passed)}};
+}
+
 // The verdict's atoms as `plan` lists them: at most ten; of a proof's atoms, those that
 // must be made or left empty when there are any: the band's only carry or block the
 // others, a voxel layer along a face or an edge rather than a feature of the part
@@ -256,9 +278,9 @@ std::string rejected_summary(const PlanningResult& r) {
   for (std::size_t i = 0; i < by_kind.size(); ++i)
     os << (i == 0 ? " (first reasons: " : ", ") << by_kind[i].first << " " << by_kind[i].second
        << (i + 1 == by_kind.size() ? ")" : "");
-  if (r.search.known_to_fail > 0)
-    os << "; " << r.search.known_to_fail << " more passed over unexecuted: they begin with the actions a rejected "
-       << "one failed in";
+  const std::int64_t repeating = r.search.known_to_fail - r.faces.passed_over;
+  if (repeating > 0)
+    os << "; " << repeating << " more passed over unexecuted: they begin with the actions a rejected one failed in";
   os << "\n";
   if (!r.learned.empty()) os << "learned     " << learned_text(r) << "\n";
   // One line each for the cheapest: the expression, the cost and the first reason, short; a
@@ -431,6 +453,7 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
                    {"exhausted", r.search.exhausted},
                    {"limit_reached", r.search.limit_reached},
                    {"known_to_fail", r.search.known_to_fail},
+                   {"faces_left_as_deposited", faces_json(r)},
                    {"weight", r.search.weight},
                    {"lower_bound", r.search.lower_bound},
                    {"seconds", r.search.seconds},
@@ -555,6 +578,11 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
   os << violations_text(r);
   os << stock_starts_text(r);
   if (r.validated) os << rejected_summary(r);
+  if (r.faces.passed_over > 0)
+    os << "faces       " << r.faces.passed_over << " plan" << (r.faces.passed_over == 1 ? "" : "s")
+       << " the search found passed over unexecuted: each leaves a face as deposited that its deposit may not leave "
+          "so (docs/search.md); the first: "
+       << r.faces.first_passed << "\n";
   if (!r.plans.empty()) {
     os << "plans       " << r.plans.size() << " (A*: " << r.search.expanded << " states expanded in "
        << fixed(r.search.seconds, 2) << " s";

@@ -320,6 +320,7 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
   r.problem = symbolic_problem(r, machine, options.max_uses);
   r.problem.start_from_stock = !options.stock_files.empty();
   r.verdict = check_manufacturability(r.problem, r.measures, r.lattice);
+  r.faces = make_face_rule(machine, r.primitives, r.problem, r.atoms, r.measures, r.tolerance);
   for (ViolatingAtom& v : r.verdict.violations)
     for (const FineGraining::Unsplit& u : r.fine_graining.unsplit)
       if (u.atom == v.atom) v.description += "; " + u.why;

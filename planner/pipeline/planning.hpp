@@ -122,6 +122,9 @@ struct PlanningResult {
   std::vector<Shortfall> learned;
   int search_rounds = 0;
   int replay_rounds = 0;
+  // Faces each deposit may not leave as it lays them (planner/pipeline/deposited_faces.hpp),
+  // and the plans the search passed over for it.
+  FaceRule faces;
   bool validated = false;              // the plans were validated (PlanningOptions::validate)
   SearchStats search;
   FineGraining fine_graining;  // what fine-graining added, and what it could not split

@@ -51,6 +51,7 @@ std::function<bool(const Plan&)> accept_hook(const PlanningOptions& options, Pla
       learning.proven.insert(sequence);
       return true;
     }
+    for (const DepositedFace& face : check.faces) learn_face(r.faces, r.problem, r.atoms, r.measures, face);
     for (const Shortfall& s : check.shortfalls) {
       const PrimitiveSpec& prim = r.problem.primitives[std::size_t(s.primitive)];
       const AtomSet& known = s.spill ? prim.atoms : prim.falls_short;
@@ -68,9 +69,18 @@ std::function<bool(const Plan&)> accept_hook(const PlanningOptions& options, Pla
 // fail the same way, and the search passes over them without executing them. The design's
 // core missing after the last deposit is such a failure only for a plan that, like the
 // rejected one, only removes after that action.
-std::function<bool(const Plan&)> known_failure_hook(const PlanningOptions& options, const PlanningResult& r) {
-  if (!options.validate) return {};
-  return [&r](const Plan& plan) {
+//
+// And plans that leave a face as deposited where the rule of deposited faces forbids it
+// (planner/pipeline/deposited_faces.hpp), validated or not: their parts are known to come
+// out beyond the tolerance there.
+std::function<bool(const Plan&)> known_failure_hook(const PlanningOptions& options, PlanningResult& r) {
+  const bool validated = bool(options.validate);
+  return [&r, validated](const Plan& plan) {
+    if (const std::optional<FaceLeft> left = face_left_as_deposited(r.problem, r.faces, plan)) {
+      if (r.faces.passed_over++ == 0) r.faces.first_passed = describe_face_left(r.problem, r.faces, r.measures, plan, *left);
+      return true;
+    }
+    if (!validated) return false;
     const auto only_removes_after = [&](std::size_t k) {
       return std::all_of(plan.steps.begin() + std::ptrdiff_t(k), plan.steps.end(), [&](const PlanStep& s) {
         return r.problem.primitives[std::size_t(s.primitive)].mode == Mode::Subtractive;
@@ -315,6 +325,10 @@ void search_plans(int top_k, const PlanningOptions& options, const Progress& pro
                                   " states expanded, weighted A* included); no atom rules the part out, but the "
                                   "primitives may not combine into it" + undecided_hint
                             : "no sequence of these primitives makes the design";
+    if (r.faces.passed_over > 0)
+      r.verdict.summary += "; " + std::to_string(r.faces.passed_over) + " plan" + (r.faces.passed_over == 1 ? "" : "s") +
+                           " the search found leave a face as deposited where its deposit may not (the first: " +
+                           r.faces.first_passed + ")";
   }
 }
 

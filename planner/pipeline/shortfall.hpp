@@ -16,6 +16,7 @@
 
 #include "geometry/solid.hpp"
 #include "planner/atoms/atoms.hpp"
+#include "planner/pipeline/deposited_faces.hpp"
 #include "plan/rejection.hpp"
 #include "planner/search/search.hpp"
 
@@ -38,6 +39,8 @@ struct CandidateCheck {
       : reasons(std::move(reasons)), shortfalls(std::move(shortfalls)) {}
   std::vector<plan::RejectionReason> reasons;
   std::vector<Shortfall> shortfalls;
+  // Faces the candidate left beyond the tolerance as deposited (exact verification).
+  std::vector<DepositedFace> faces;
 };
 
 // An atom the plan needs falls short when, after the plan's first `steps` actions, less
