@@ -31,6 +31,9 @@ struct Op {
   int head = -1;   // index into machine.heads for a bead laid; -1 for a cut
 };
 
+// Shorter than this along a vector (mm), a span holds no material.
+constexpr double kNoLength = 1e-9;
+
 // One interval of material along a vector, with the operation that made each end.
 struct Run {
   double lo = 0, hi = 0;
@@ -163,7 +166,9 @@ class Verifier {
             // A cut is asked only about the stretch that still holds material.
             const Span span = cuts ? line_in_sweep(piece, step.segment, v.point, v.normal, runs.front().lo, runs.back().hi)
                                    : line_in_sweep(piece, step.segment, v.point, v.normal, v.t0, v.t1);
-            if (span.empty()) return;
+            // A bead that only touches the vector's end leaves a span of no length there: no
+            // material, and a run no cut could take away again (a cut's span ends there too).
+            if (span.empty() || (!cuts && span.hi - span.lo < kNoLength)) return;
             if (cuts) subtract(runs, span, step.op, scratch);
             else unite(runs, span, step.op, scratch);
           });

@@ -112,5 +112,25 @@ TEST(ExactDeviation, AFaceLeftAsDepositedCarriesItsHeadsAccuracy) {
   EXPECT_GE(std::max(d.excess.mm, d.gouge.mm), m.heads[0].accuracy);
 }
 
+TEST(ExactDeviation, ABeadThatOnlyTouchesAVectorsEndLeavesNothingACutMustTakeAway) {
+  // A bead laid on top of a 10 mm cube with its underside at z 12, exactly where the top
+  // face's vectors end (2 mm out at this tolerance), then the top faced at z 10. The bead
+  // meets those vectors in a single point: no material. It used to stay on them as a run of
+  // no length that no cut could take away (a cut's span ends there too), and the faced top
+  // came out "at least 2 mm" high, as on the boss plate's plate face round its deposited boss.
+  const geometry::TriangleMesh cube = testing::box_mesh({20, 20, 0}, {30, 30, 10});
+  const geometry::Solid stock = stock_box({20, 20, 0}, {30, 30, 10});
+  const gcode::PostedProgram laid_then_faced =
+      program({"G21 G90 G17 G54", "T100 M6", "G0 X21 Y25 Z12", "M64 P0", "G1 X29 F800", "M65 P0", "G0 Z20", "T1 M6",
+               "S8000 M3", "G0 X12 Y17 Z20", "G1 Z10 F300", "G1 X38 F1200", "G1 Y21", "G1 X12", "G1 Y25", "G1 X38",
+               "G1 Y29", "G1 X12", "G1 Y33", "G1 X38", "G0 Z20", "M5", "M2"});
+  const DesignSurface surface(cube, "cube", sampling_for(0.5, 0.5));
+  const plan::ExactDeviation d = verify_program(surface, machine(), laid_then_faced, stock, {0.5});
+  EXPECT_LT(d.excess.mm, 1e-6);
+  EXPECT_FALSE(d.excess.at_least);
+  EXPECT_LT(d.gouge.mm, 1e-6);
+  EXPECT_TRUE(d.within_tolerance());
+}
+
 }  // namespace
 }  // namespace hybridctl::verification
