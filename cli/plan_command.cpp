@@ -13,6 +13,7 @@
 #include "config/machine_loader.hpp"
 #include "planner/pipeline/candidate_execution.hpp"
 #include "planner/pipeline/plan_report.hpp"
+#include "planner/pipeline/ways_compared.hpp"
 #include "validation/plan_validator.hpp"
 #include "verification/exact_deviation.hpp"
 #include "gcode/post.hpp"
@@ -42,6 +43,7 @@ struct PlanArgs {
   std::string objective;
   int max_rejected = 200;
   bool report = false;
+  bool compare = false;
 };
 
 planner::PrimitiveFile parse_primitive_argument(const std::string& arg) {
@@ -58,29 +60,34 @@ int run_plan(const PlanArgs& args) {
     throw InputError("--report: the report is made from the plan directory: give -o DIR (or --export DIR)");
   const std::string machine_text = config::read_machine_text(args.machine);
   const config::Machine machine = gcode::parse_postable_machine(machine_text, args.machine);
-  planner::PlanningOptions options;
-  options.voxel_size = args.voxel;
-  options.memory_budget = memory_budget(args.memory_budget);
-  options.tolerance = args.tolerance;
-  options.top_k = args.top;
-  options.max_uses = args.reuse;
-  options.search_time = args.search_time;
-  for (const std::string& p : args.primitive_files) options.extra_primitives.push_back(parse_primitive_argument(p));
-  options.stock_files = args.stock_files;
   const geometry::TriangleMesh mesh = geometry::read_stl(args.part);
-  // Every plan offered is proven by execution first (validation/, docs/validation.md), and
-  // the part it makes verified against the STL's real surface (docs/verification.md).
-  if (!args.no_validate) {
-    validation::ExecutionOptions proving;
-    proving.surfaces = std::make_shared<verification::DesignSurfaces>(mesh, args.part);
-    planner::validate_by_execution(options, validation::plan_validator(machine, std::move(proving)), machine.name);
-  }
-  options.bands = !args.no_bands;
-  options.fine_graining = !args.no_fine_graining;
-  options.filled = !args.no_filled;
-  options.learn = !args.no_learning;
-  options.objective = objective(args.objective);
-  options.max_rejected = args.max_rejected;
+  // The options for planning on `on` (the machine file's, or a copy --compare plans on).
+  const auto options_for = [&](const config::Machine& on) {
+    planner::PlanningOptions options;
+    options.voxel_size = args.voxel;
+    options.memory_budget = memory_budget(args.memory_budget);
+    options.tolerance = args.tolerance;
+    options.top_k = args.top;
+    options.max_uses = args.reuse;
+    options.search_time = args.search_time;
+    for (const std::string& p : args.primitive_files) options.extra_primitives.push_back(parse_primitive_argument(p));
+    options.stock_files = args.stock_files;
+    // Every plan offered is proven by execution first (validation/, docs/validation.md), and
+    // the part it makes verified against the STL's real surface (docs/verification.md).
+    if (!args.no_validate) {
+      validation::ExecutionOptions proving;
+      proving.surfaces = std::make_shared<verification::DesignSurfaces>(mesh, args.part);
+      planner::validate_by_execution(options, validation::plan_validator(on, std::move(proving)), on.name);
+    }
+    options.bands = !args.no_bands;
+    options.fine_graining = !args.no_fine_graining;
+    options.filled = !args.no_filled;
+    options.learn = !args.no_learning;
+    options.objective = objective(args.objective);
+    options.max_rejected = args.max_rejected;
+    return options;
+  };
+  planner::PlanningOptions options = options_for(machine);
   ProgressBar bar("planning");
   std::string current;
   options.progress = [&](const std::string& phase, double f) {
@@ -94,6 +101,18 @@ int run_plan(const PlanArgs& args) {
   bar.finish();
   const planner::ReportSources sources{args.part, args.machine, machine.name, machine_text};
   std::fputs(planner::plan_summary(result, sources).c_str(), stdout);
+  if (args.compare) {
+    ProgressBar others("comparing");
+    int planned = 0;
+    const planner::WaysCompared compared =
+        planner::compare_ways(machine, result, [&](const config::Machine& on) {
+          const planner::PlanningResult r = planner::plan_part(mesh, args.part, on, options_for(on));
+          others.update(++planned / 2.0);
+          return r;
+        });
+    others.finish();
+    std::fputs(planner::ways_compared_text(compared).c_str(), stdout);
+  }
   const std::string plan_dir = !args.output.empty() ? args.output : args.export_dir.empty() ? "" : args.export_dir + "/plan";
   if (!plan_dir.empty()) {
     if (args.output.empty()) std::filesystem::create_directories(args.export_dir);
@@ -147,6 +166,10 @@ void add_plan_command(CLI::App& app, Runner& runner) {
                   "-o, or to DIR/plan)");
   cmd->add_flag("--report", args->report,
                 "Also write the job report, DIR/report.html and its PNG snapshots (as `hybridctl report DIR`)");
+  cmd->add_flag("--compare", args->compare,
+                "Also plan the part milled from stock only (the machine without its heads) and deposited only "
+                "(without its tools), and print each way's best plan with its machine time and money beside the "
+                "hybrid one (docs/costs.md)");
   cmd->add_option("--dialect", args->dialect, "With --export: rs274ngc or fanuc (default: the machine file's)");
   cmd->add_option("--voxel", args->voxel, "Voxel size in mm (default: the machine file's planning.voxel_size)")
       ->check(greater_than(0));
