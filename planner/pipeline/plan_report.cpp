@@ -441,6 +441,7 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
                     {"decided_without_search", r.verdict.decided_without_search},
                     {"modality", modality_name(r.verdict.modality)},
                     {"summary", r.verdict.summary},
+                    {"in_shop_words", r.in_shop_words},
                     {"violations", violations}};
   json unsplit = json::array();
   for (const FineGraining::Unsplit& u : r.fine_graining.unsplit) unsplit.push_back({{"atom", u.atom}, {"why", u.why}});
@@ -575,6 +576,8 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
                                                                 : "NOT manufacturable")
      << ": " << r.verdict.summary
      << "\n";
+  for (std::size_t i = 0; i < r.in_shop_words.size(); ++i)
+    os << (i == 0 ? "in words    " : "            ") << r.in_shop_words[i] << "\n";
   os << violations_text(r);
   os << stock_starts_text(r);
   if (r.validated) os << rejected_summary(r);

@@ -27,6 +27,7 @@
 #include "planner/atoms/fine_graining.hpp"
 #include "planner/pipeline/memory_estimate.hpp"
 #include "planner/pipeline/search_phase.hpp"
+#include "planner/pipeline/shop_words.hpp"
 #include "planner/primitives/repair.hpp"
 #include "planner/search/steps.hpp"
 
@@ -336,6 +337,7 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
   }
   if (r.verdict.manufacturable()) search_phase(top_k, options, progress, r, validation_seconds);
   settle_outcome(r);
+  r.in_shop_words = refusal_in_shop_words(machine, r);
   clock.lap("search");
   if (r.validated) {
     // The search's lap holds the validation it called: report them apart.

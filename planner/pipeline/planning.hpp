@@ -110,6 +110,9 @@ struct PlanningResult {
   std::vector<AtomMeasures> measures;
   PlanningProblem problem;
   Verdict verdict;
+  // A refusal's regions of air in a shop's words (planner/pipeline/shop_words.hpp); empty
+  // for a part with plans.
+  std::vector<std::string> in_shop_words;
   std::vector<Plan> plans;
   std::vector<plan::Deviation> deviations;  // one per plan: its outcome against the design, on the voxels
   // One per plan: the part its program makes against the design's real surface (none:

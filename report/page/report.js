@@ -221,6 +221,8 @@
     const v = data.verdict || {};
     panel.append(el('h2', '', 'Verdict'));
     panel.append(el('div', '', v.summary || ''));
+    // The refusal's places in a shop's words (plan.json verdict.in_shop_words), as `plan` prints them.
+    (v.in_shop_words || []).forEach((line) => panel.append(el('div', 'in-shop-words', line)));
     const violations = v.violations || [];
     if (!violations.length) return;
     const group = new THREE.Group();

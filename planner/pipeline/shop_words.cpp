@@ -1,0 +1,172 @@
+#include "planner/pipeline/shop_words.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+
+#include "common/number_text.hpp"
+
+namespace hybridctl::planner {
+namespace {
+
+using geometry::Index3;
+
+struct Direction {
+  Index3 step;
+  const char* name;
+  config::Approach approach;
+};
+constexpr std::array<Direction, 6> kDirections{{{{1, 0, 0}, "+X", config::Approach::PlusX},
+                                                {{-1, 0, 0}, "-X", config::Approach::MinusX},
+                                                {{0, 1, 0}, "+Y", config::Approach::PlusY},
+                                                {{0, -1, 0}, "-Y", config::Approach::MinusY},
+                                                {{0, 0, 1}, "+Z", config::Approach::PlusZ},
+                                                {{0, 0, -1}, "-Z", config::Approach::MinusZ}}};
+
+// The atom's voxels, at most about `cap` of them, evenly.
+std::vector<Index3> voxels_of(const geometry::Solid& atom, std::size_t cap) {
+  std::vector<Index3> all;
+  const geometry::IndexBox b = atom.bounding_box();
+  for (int z = b.lo.z; z < b.hi.z; ++z)
+    for (int y = b.lo.y; y < b.hi.y; ++y)
+      for (int x = b.lo.x; x < b.hi.x; ++x)
+        if (atom.contains({x, y, z})) all.push_back({x, y, z});
+  if (all.size() <= cap) return all;
+  std::vector<Index3> some;
+  const double stride = double(all.size()) / double(cap);
+  for (std::size_t k = 0; k < cap; ++k) some.push_back(all[std::size_t(double(k) * stride)]);
+  return some;
+}
+
+// Nothing of the design between `v` and the domain's edge along `d`.
+bool open_towards(const geometry::Solid& design, const geometry::IndexBox& domain, Index3 v, Index3 d) {
+  for (Index3 p{v.x + d.x, v.y + d.y, v.z + d.z}; domain.contains(p); p = {p.x + d.x, p.y + d.y, p.z + d.z})
+    if (design.contains(p)) return false;
+  return true;
+}
+
+// The width of the gap at `v` across `d` (in the plane square to it), mm: between walls of
+// the design on opposite sides along one of the plane's two axes, within `reach` voxels
+// each way; the narrower of the two where both have such walls; none (a negative number)
+// where neither has: open across, or a corner (walls on one side of each axis only).
+double gap_width(const geometry::Solid& design, Index3 v, Index3 d, int reach, double h) {
+  const std::array<Index3, 3> axes{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+  double width = -1;
+  for (const Index3& u : axes) {
+    if (u.x * d.x + u.y * d.y + u.z * d.z != 0) continue;  // the approach's own axis
+    int sides[2] = {0, 0};
+    for (int side = 0; side < 2; ++side) {
+      const int sign = side == 0 ? 1 : -1;
+      for (int k = 1; k <= reach && sides[side] == 0; ++k)
+        if (design.contains({v.x + sign * k * u.x, v.y + sign * k * u.y, v.z + sign * k * u.z})) sides[side] = k;
+    }
+    if (sides[0] == 0 || sides[1] == 0) continue;
+    const double w = (sides[0] + sides[1] - 1) * h;
+    width = width < 0 ? w : std::min(width, w);
+  }
+  return width;
+}
+
+std::string around(const geometry::Vec3& c) {
+  char s[80];
+  std::snprintf(s, sizeof s, "(%.1f, %.1f, %.1f) mm", c.x, c.y, c.z);
+  return s;
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (std::size_t i = 0; i < names.size(); ++i) out += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + names[i];
+  return out;
+}
+
+// One region of air in words: what it is, why no instrument clears it, what would.
+std::string air_in_words(const config::Machine& machine, const PlanningResult& r, const ViolatingAtom& v) {
+  const double h = r.lattice.voxel_size;
+  const std::vector<Index3> voxels = voxels_of(r.atoms.atom_solid(v.atom), 1500);
+  std::vector<const Direction*> open;
+  std::array<std::vector<Index3>, 6> free;
+  for (std::size_t k = 0; k < kDirections.size(); ++k) {
+    for (const Index3& p : voxels)
+      if (open_towards(r.design, r.domain, p, kDirections[k].step)) free[k].push_back(p);
+    if (!free[k].empty()) open.push_back(&kDirections[k]);
+  }
+  const std::string volume = trimmed_number(v.volume, v.volume < 10 ? 2 : 0) + " mm\u00B3";
+  if (open.empty())
+    return "closed space: a " + volume + " cavity around " + around(v.centroid) +
+           " is closed in by the part on every side: no cutter reaches it from any direction, and no deposit "
+           "closes over it without something under its first layer; an opening to it in the design, or the part made "
+           "in two pieces, would do";
+  const auto has_setup = [&](const Direction& d) {
+    return std::any_of(machine.setups.begin(), machine.setups.end(),
+                       [&](const config::Setup& s) { return s.approach == d.approach; });
+  };
+  std::vector<std::string> open_names, unset;
+  for (const Direction* d : open) {
+    open_names.push_back(d->name);
+    if (!has_setup(*d)) unset.push_back(d->name);
+  }
+  if (unset.size() == open.size()) {
+    const geometry::Box3 part = r.design.bounding_box_mm();
+    const bool under = unset.size() == 1 && unset.front() == std::string("-Z") && v.bounds.max.z <= part.min.z + r.band + 1e-9;
+    const std::string what = under ? "underside: " + trimmed_number(v.bounds.max.z - v.bounds.min.z, 1) +
+                                         " mm of stock under the part around " + around(v.centroid)
+                                   : "a " + volume + " region around " + around(v.centroid);
+    return what + " can only be cut from " + joined(unset) + ", and the machine has no setup from " +
+           (unset.size() == 1 ? "there" : "any of them") + "; " +
+           (under ? "a stock flush with the part's bottom, or a setup from -Z, would do"
+                  : "a setup from " + unset.front() + " would do");
+  }
+  // Open to a setup: do the cutters fit?
+  double widest = 0;
+  std::string widest_side;
+  const config::CuttingTool* smallest = nullptr;
+  for (const config::CuttingTool& t : machine.tools)
+    if (!smallest || t.diameter < smallest->diameter) smallest = &t;
+  if (!smallest) return {};
+  // The widest gap the region offers a cutter from a setup's side: the largest over its
+  // voxels open to that side; a voxel open across, with no walls on opposite sides, is no
+  // slot at all.
+  const int reach = int(std::ceil(smallest->diameter / h)) + 1;
+  for (std::size_t k = 0; k < kDirections.size(); ++k) {
+    if (free[k].empty() || !has_setup(kDirections[k])) continue;
+    for (const Index3& p : free[k]) {
+      const double w = gap_width(r.design, p, kDirections[k].step, reach, h);
+      if (w < 0) return {};
+      if (w > widest) widest = w, widest_side = kDirections[k].name;
+    }
+  }
+  if (smallest->diameter > widest + 1e-9)
+    return "narrow slot: a " + volume + " gap around " + around(v.centroid) + " is " + trimmed_number(widest, 2) +
+           " mm wide at most where it opens to " + widest_side + "; the smallest cutter, " + smallest->name + " (" +
+           trimmed_number(smallest->diameter, 2) + " mm), does not fit; a cutter of " + trimmed_number(widest, 2) +
+           " mm or less across would do";
+  // Open to a setup, and a cutter fits: what stops it is past the part's other walls
+  // (shanks, holders) or in combination with other regions; the verdict's list says which.
+  return {};
+}
+
+}  // namespace
+
+std::vector<std::string> refusal_in_shop_words(const config::Machine& machine, const PlanningResult& r, std::size_t limit) {
+  std::vector<std::string> out;
+  if (r.verdict.manufacturable() && !r.plans.empty()) return out;
+  std::vector<const ViolatingAtom*> air;
+  for (const ViolatingAtom& v : r.verdict.violations) {
+    const std::size_t a = std::size_t(v.atom);
+    if (a < r.problem.atoms.size() && r.problem.atoms[a].must_out && v.volume_in_design <= 0) air.push_back(&v);
+  }
+  for (const ViolatingAtom* v : air) {
+    if (out.size() >= limit) break;
+    const std::string line = air_in_words(machine, r, *v);
+    // The same slot's other regions (its floor, its ends) say the same thing again.
+    const auto same_gap = [&](const std::string& told) {
+      const std::size_t a = line.find(" mm wide at most"), b = told.find(" mm wide at most");
+      return a != std::string::npos && b != std::string::npos && line.substr(a) == told.substr(b);
+    };
+    if (!line.empty() && std::none_of(out.begin(), out.end(), same_gap)) out.push_back(line);
+  }
+  return out;
+}
+
+}  // namespace hybridctl::planner

@@ -1,0 +1,61 @@
+// A refusal in a shop's words (planner/pipeline/shop_words.hpp), on the B-axis machine
+// (setups +Z, +X, -X, +Y; its smallest cutter 4 mm): the lidded channel block's channel is
+// a closed space, the thin-wall block's 2.5 mm slot is narrower than any cutter; what the
+// shop would change is said with it.
+
+#include <gtest/gtest.h>
+
+#include "config/machine_loader.hpp"
+#include "geometry/mesh.hpp"
+#include "planner/pipeline/shop_words.hpp"
+
+namespace hybridctl::planner {
+namespace {
+
+const std::string kParts = HYBRIDCTL_SOURCE_DIR "/examples/parts/";
+const std::string kMultitask = HYBRIDCTL_SOURCE_DIR "/examples/machines/multitask-b-axis.yaml";
+
+PlanningResult plan(const std::string& part) {
+  const config::Machine machine = config::load_machine(kMultitask);
+  PlanningOptions options;
+  options.max_expansions = 1;  // the proof decides before any search
+  return plan_part(geometry::read_stl(kParts + part + ".stl"), part, machine, options);
+}
+
+TEST(ShopWords, AClosedChannelIsAClosedSpaceNoCutterReaches) {
+  const PlanningResult r = plan("lidded-channel-block");
+  ASSERT_EQ(r.verdict.outcome, Verdict::Outcome::NotManufacturable) << r.verdict.summary;
+  ASSERT_FALSE(r.in_shop_words.empty());
+  const std::string& first = r.in_shop_words.front();
+  EXPECT_EQ(first.rfind("closed space: a 205 mm\u00B3 cavity around (25.0, 14.6, 17.0) mm is closed in by the part on "
+                        "every side: no cutter reaches it from any direction",
+                        0),
+            0u)
+      << first;
+  EXPECT_NE(first.find("an opening to it in the design, or the part made in two pieces, would do"), std::string::npos);
+  // The same words as plan_part keeps them, for the machine it was planned on.
+  EXPECT_EQ(refusal_in_shop_words(config::load_machine(kMultitask), r), r.in_shop_words);
+}
+
+TEST(ShopWords, ASlotNarrowerThanTheSmallestCutterSaysHowWideAndWhichCutter) {
+  const PlanningResult r = plan("thin-wall-slot");
+  ASSERT_EQ(r.verdict.outcome, Verdict::Outcome::NotManufacturable) << r.verdict.summary;
+  ASSERT_FALSE(r.in_shop_words.empty());
+  const std::string& first = r.in_shop_words.front();
+  EXPECT_EQ(first.rfind("narrow slot: a 145 mm\u00B3 gap around (53.7, 14.9, 24.8) mm is 2.5 mm wide at most", 0), 0u) << first;
+  EXPECT_NE(first.find("the smallest cutter, 4 mm flat detail (4 mm), does not fit; a cutter of 2.5 mm or less across would do"),
+            std::string::npos)
+      << first;
+  // Its floor's and ends' regions are the same slot: said once.
+  EXPECT_EQ(r.in_shop_words.size(), 1u);
+}
+
+TEST(ShopWords, APartWithPlansNeedsNoWords) {
+  PlanningResult r;
+  r.verdict.outcome = Verdict::Outcome::Manufacturable;
+  r.plans.push_back(Plan{});
+  EXPECT_TRUE(refusal_in_shop_words(config::load_machine(kMultitask), r).empty());
+}
+
+}  // namespace
+}  // namespace hybridctl::planner
