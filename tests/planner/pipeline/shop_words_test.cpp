@@ -5,22 +5,15 @@
 
 #include <gtest/gtest.h>
 
-#include "config/machine_loader.hpp"
-#include "geometry/mesh.hpp"
 #include "planner/pipeline/shop_words.hpp"
+#include "proof_on_multitask.hpp"
 
 namespace hybridctl::planner {
 namespace {
 
-const std::string kParts = HYBRIDCTL_SOURCE_DIR "/examples/parts/";
-const std::string kMultitask = HYBRIDCTL_SOURCE_DIR "/examples/machines/multitask-b-axis.yaml";
+using testing::kMultitask;
 
-PlanningResult plan(const std::string& part) {
-  const config::Machine machine = config::load_machine(kMultitask);
-  PlanningOptions options;
-  options.max_expansions = 1;  // the proof decides before any search
-  return plan_part(geometry::read_stl(kParts + part + ".stl"), part, machine, options);
-}
+PlanningResult plan(const std::string& part) { return testing::proof_on_multitask(part); }
 
 TEST(ShopWords, AClosedChannelIsAClosedSpaceNoCutterReaches) {
   const PlanningResult r = plan("lidded-channel-block");
