@@ -80,10 +80,31 @@ std::string joined(const std::vector<std::string>& names) {
   return out;
 }
 
+// Closed spaces: `count` regions of `air` mm^3 in all, the first around `at`.
+std::string closed_space_words(double air, int count, const geometry::Vec3& at) {
+  const std::string volume = trimmed_number(air, air < 10 ? 2 : 0) + " mm\u00B3";
+  return std::string("closed space: ") + (count == 1 ? "a " + volume + " cavity" : volume + " of cavities in " + std::to_string(count) + " regions") +
+         " around " + around(at) +
+         (count == 1 ? " is" : " are") +
+         " closed in by the part on every side: no cutter reaches " + (count == 1 ? "it" : "them") +
+         " from any direction, and no deposit closes over " + (count == 1 ? "it" : "them") +
+         " without something under its first layer; an opening in the design, or the part made in two pieces, would do";
+}
+
 // One region of air in words: what it is, why no instrument clears it, what would.
-std::string air_in_words(const config::Machine& machine, const PlanningResult& r, const ViolatingAtom& v) {
+struct AirWords {
+  bool closed = false;  // a closed space, said once for all of them
+  double air = 0;       // mm^3
+  geometry::Vec3 at;    // mm: the middle of its air
+  std::string line;     // empty: nothing certain to say
+};
+
+AirWords air_in_words(const config::Machine& machine, const PlanningResult& r, const ViolatingAtom& v) {
   const double h = r.lattice.voxel_size;
-  const std::vector<Index3> voxels = voxels_of(r.atoms.atom_solid(v.atom), 1500);
+  // Its air only: an atom that straddles the design holds some of both.
+  const std::vector<Index3> voxels = voxels_of(geometry::subtract(r.atoms.atom_solid(v.atom), r.design), 1500);
+  if (voxels.empty()) return {};
+  AirWords said;
   std::vector<const Direction*> open;
   std::array<std::vector<Index3>, 6> free;
   for (std::size_t k = 0; k < kDirections.size(); ++k) {
@@ -91,12 +112,21 @@ std::string air_in_words(const config::Machine& machine, const PlanningResult& r
       if (open_towards(r.design, r.domain, p, kDirections[k].step)) free[k].push_back(p);
     if (!free[k].empty()) open.push_back(&kDirections[k]);
   }
-  const std::string volume = trimmed_number(v.volume, v.volume < 10 ? 2 : 0) + " mm\u00B3";
-  if (open.empty())
-    return "closed space: a " + volume + " cavity around " + around(v.centroid) +
-           " is closed in by the part on every side: no cutter reaches it from any direction, and no deposit "
-           "closes over it without something under its first layer; an opening to it in the design, or the part made "
-           "in two pieces, would do";
+  geometry::Vec3 at{0, 0, 0};
+  for (const Index3& p : voxels) {
+    const geometry::Vec3 c = r.lattice.center(p);
+    at = {at.x + c.x, at.y + c.y, at.z + c.z};
+  }
+  const double n = double(voxels.size());
+  at = {at.x / n, at.y / n, at.z / n};
+  const double air = v.volume - v.volume_in_design;
+  const std::string volume = trimmed_number(air, air < 10 ? 2 : 0) + " mm\u00B3";
+  said.air = air;
+  said.at = at;
+  if (open.empty()) {
+    said.closed = true;
+    return said;
+  }
   const auto has_setup = [&](const Direction& d) {
     return std::any_of(machine.setups.begin(), machine.setups.end(),
                        [&](const config::Setup& s) { return s.approach == d.approach; });
@@ -110,12 +140,13 @@ std::string air_in_words(const config::Machine& machine, const PlanningResult& r
     const geometry::Box3 part = r.design.bounding_box_mm();
     const bool under = unset.size() == 1 && unset.front() == std::string("-Z") && v.bounds.max.z <= part.min.z + r.band + 1e-9;
     const std::string what = under ? "underside: " + trimmed_number(v.bounds.max.z - v.bounds.min.z, 1) +
-                                         " mm of stock under the part around " + around(v.centroid)
-                                   : "a " + volume + " region around " + around(v.centroid);
-    return what + " can only be cut from " + joined(unset) + ", and the machine has no setup from " +
+                                         " mm of stock under the part around " + around(at)
+                                   : "a " + volume + " region around " + around(at);
+    said.line = what + " can only be cut from " + joined(unset) + ", and the machine has no setup from " +
            (unset.size() == 1 ? "there" : "any of them") + "; " +
            (under ? "a stock flush with the part's bottom, or a setup from -Z, would do"
                   : "a setup from " + unset.front() + " would do");
+    return said;
   }
   // Open to a setup: do the cutters fit?
   double widest = 0;
@@ -123,7 +154,7 @@ std::string air_in_words(const config::Machine& machine, const PlanningResult& r
   const config::CuttingTool* smallest = nullptr;
   for (const config::CuttingTool& t : machine.tools)
     if (!smallest || t.diameter < smallest->diameter) smallest = &t;
-  if (!smallest) return {};
+  if (!smallest) return said;
   // The widest gap the region offers a cutter from a setup's side: the largest over its
   // voxels open to that side; a voxel open across, with no walls on opposite sides, is no
   // slot at all.
@@ -132,18 +163,18 @@ std::string air_in_words(const config::Machine& machine, const PlanningResult& r
     if (free[k].empty() || !has_setup(kDirections[k])) continue;
     for (const Index3& p : free[k]) {
       const double w = gap_width(r.design, p, kDirections[k].step, reach, h);
-      if (w < 0) return {};
+      if (w < 0) return said;
       if (w > widest) widest = w, widest_side = kDirections[k].name;
     }
   }
   if (smallest->diameter > widest + 1e-9)
-    return "narrow slot: a " + volume + " gap around " + around(v.centroid) + " is " + trimmed_number(widest, 2) +
+    said.line = "narrow slot: a " + volume + " gap around " + around(at) + " is " + trimmed_number(widest, 2) +
            " mm wide at most where it opens to " + widest_side + "; the smallest cutter, " + smallest->name + " (" +
            trimmed_number(smallest->diameter, 2) + " mm), does not fit; a cutter of " + trimmed_number(widest, 2) +
            " mm or less across would do";
-  // Open to a setup, and a cutter fits: what stops it is past the part's other walls
-  // (shanks, holders) or in combination with other regions; the verdict's list says which.
-  return {};
+  // Otherwise open to a setup, and a cutter fits: what stops it is past the part's other
+  // walls (shanks, holders) or in combination with other regions; the verdict's list says which.
+  return said;
 }
 
 }  // namespace
@@ -154,18 +185,29 @@ std::vector<std::string> refusal_in_shop_words(const config::Machine& machine, c
   std::vector<const ViolatingAtom*> air;
   for (const ViolatingAtom& v : r.verdict.violations) {
     const std::size_t a = std::size_t(v.atom);
-    if (a < r.problem.atoms.size() && r.problem.atoms[a].must_out && v.volume_in_design <= 0) air.push_back(&v);
+    if (a < r.problem.atoms.size() && r.problem.atoms[a].must_out) air.push_back(&v);
   }
+  // Closed spaces are said once, the regions of air they are split into added up.
+  std::size_t closed_line = 0;
+  int closed = 0;
+  double closed_air = 0;
+  geometry::Vec3 closed_at;
   for (const ViolatingAtom* v : air) {
-    if (out.size() >= limit) break;
-    const std::string line = air_in_words(machine, r, *v);
+    const AirWords said = air_in_words(machine, r, *v);
+    if (said.closed) {
+      if (closed++ == 0) closed_line = out.size(), closed_at = said.at, out.emplace_back();
+      closed_air += said.air;
+      continue;
+    }
+    if (said.line.empty() || out.size() >= limit) continue;
     // The same slot's other regions (its floor, its ends) say the same thing again.
     const auto same_gap = [&](const std::string& told) {
-      const std::size_t a = line.find(" mm wide at most"), b = told.find(" mm wide at most");
-      return a != std::string::npos && b != std::string::npos && line.substr(a) == told.substr(b);
+      const std::size_t a = said.line.find(" mm wide at most"), b = told.find(" mm wide at most");
+      return a != std::string::npos && b != std::string::npos && said.line.substr(a) == told.substr(b);
     };
-    if (!line.empty() && std::none_of(out.begin(), out.end(), same_gap)) out.push_back(line);
+    if (std::none_of(out.begin(), out.end(), same_gap)) out.push_back(said.line);
   }
+  if (closed > 0) out[closed_line] = closed_space_words(closed_air, closed, closed_at);
   return out;
 }
 

@@ -14,7 +14,8 @@
 
 namespace hybridctl::planner {
 
-// One line per region of air the verdict names, in its order (the proof's heart first), at
+// One line per region of air the verdict names (a region that straddles the design: its
+// air), in its order (the proof's heart first), at
 // most `limit`, for the regions it can say it of with certainty: closed in on every side,
 // open only where the machine has no setup, or narrower than its smallest cutter. None for
 // a part with plans, or a verdict that names no such air.

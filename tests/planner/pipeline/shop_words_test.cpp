@@ -25,9 +25,30 @@ TEST(ShopWords, AClosedChannelIsAClosedSpaceNoCutterReaches) {
                         0),
             0u)
       << first;
-  EXPECT_NE(first.find("an opening to it in the design, or the part made in two pieces, would do"), std::string::npos);
+  EXPECT_NE(first.find("an opening in the design, or the part made in two pieces, would do"), std::string::npos);
   // The same words as plan_part keeps them, for the machine it was planned on.
   EXPECT_EQ(refusal_in_shop_words(config::load_machine(kMultitask), r), r.in_shop_words);
+}
+
+// Milled only (the machine without its heads), the channel block's closed round channel
+// is no atom of its own: no primitive parts it from the design round it, and the verdict
+// names the regions that straddle the design. Their air is the channel, said once.
+TEST(ShopWords, AClosedChannelSplitAmongRegionsThatStraddleTheDesignIsSaidOnce) {
+  config::Machine milling = config::load_machine(kMultitask);
+  milling.heads.clear();
+  const PlanningResult r =
+      plan_part(geometry::read_stl(testing::kParts + "channel-block.stl"), "channel-block", milling, PlanningOptions{});
+  ASSERT_EQ(r.verdict.outcome, Verdict::Outcome::NotManufacturable) << r.verdict.summary;
+  ASSERT_GT(r.verdict.violations.size(), 1u);
+  ASSERT_EQ(r.in_shop_words.size(), 1u);
+  const std::string& line = r.in_shop_words.front();
+  EXPECT_EQ(line.rfind("closed space: ", 0), 0u) << line;
+  EXPECT_NE(line.find(" regions around "), std::string::npos) << line;
+  EXPECT_NE(line.find(" are closed in by the part on every side: no cutter reaches them"), std::string::npos) << line;
+  // The channel is 8 mm across and 48 long: about 2,400 mm^3 of air.
+  const double air = std::stod(line.substr(14));
+  EXPECT_GT(air, 2200);
+  EXPECT_LT(air, 2700);
 }
 
 TEST(ShopWords, ASlotNarrowerThanTheSmallestCutterSaysHowWideAndWhichCutter) {
