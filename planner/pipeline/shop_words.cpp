@@ -137,15 +137,23 @@ AirWords air_in_words(const config::Machine& machine, const PlanningResult& r, c
     if (!has_setup(*d)) unset.push_back(d->name);
   }
   if (unset.size() == open.size()) {
+    // Air wholly under the part, with -Z among the ways to it: the stock's margin under the
+    // part, which only a setup from below reaches (or from the sides, had the machine them).
+    double low = 1e300, high = -1e300;
+    for (const Index3& p : voxels) {
+      const double z = r.lattice.center(p).z;
+      low = std::min(low, z), high = std::max(high, z);
+    }
     const geometry::Box3 part = r.design.bounding_box_mm();
-    const bool under = unset.size() == 1 && unset.front() == std::string("-Z") && v.bounds.max.z <= part.min.z + r.band + 1e-9;
-    const std::string what = under ? "underside: " + trimmed_number(v.bounds.max.z - v.bounds.min.z, 1) +
+    const bool under = std::find(unset.begin(), unset.end(), std::string("-Z")) != unset.end() &&
+                       high <= part.min.z + r.band + 1e-9;
+    const std::string what = under ? "underside: " + trimmed_number(high - low + h, 1) +
                                          " mm of stock under the part around " + around(at)
                                    : "a " + volume + " region around " + around(at);
     said.line = what + " can only be cut from " + joined(unset) + ", and the machine has no setup from " +
-           (unset.size() == 1 ? "there" : "any of them") + "; " +
-           (under ? "a stock flush with the part's bottom, or a setup from -Z, would do"
-                  : "a setup from " + unset.front() + " would do");
+                (unset.size() == 1 ? "there" : "any of them") + "; " +
+                (under ? "a stock flush with the part's bottom, or a setup from -Z, would do"
+                       : "a setup from " + (unset.size() == 1 ? unset.front() : std::string("one of them")) + " would do");
     return said;
   }
   // Open to a setup: do the cutters fit?

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "planner/pipeline/shop_words.hpp"
+#include "../../geometry/mesh_fixtures.hpp"
 #include "proof_on_multitask.hpp"
 
 namespace hybridctl::planner {
@@ -62,6 +63,22 @@ TEST(ShopWords, ASlotNarrowerThanTheSmallestCutterSaysHowWideAndWhichCutter) {
       << first;
   // Its floor's and ends' regions are the same slot: said once.
   EXPECT_EQ(r.in_shop_words.size(), 1u);
+}
+
+// A 3-axis mill with only its +Z setup (hybrid-3axis without its bottom setup and heads),
+// and a box milled from the plate stock, which stands 3 mm under the part: nothing but a
+// setup from below, or from a side, reaches that margin.
+TEST(ShopWords, StockUnderThePartWithoutASetupFromBelowIsTheUnderside) {
+  config::Machine top_only = config::load_machine(HYBRIDCTL_SOURCE_DIR "/examples/machines/hybrid-3axis.yaml");
+  top_only.heads.clear();
+  std::erase_if(top_only.setups, [](const config::Setup& s) { return s.approach != config::Approach::PlusZ; });
+  const PlanningResult r = plan_part(geometry::testing::box_mesh({0, 0, 0}, {20, 16, 10}), "box", top_only, PlanningOptions{});
+  ASSERT_EQ(r.verdict.outcome, Verdict::Outcome::NotManufacturable) << r.verdict.summary;
+  ASSERT_EQ(r.in_shop_words.size(), 1u);
+  EXPECT_EQ(r.in_shop_words.front(),
+            "underside: 3 mm of stock under the part around (9.9, 8.0, -1.5) mm can only be cut from +X, -X, +Y, -Y "
+            "and -Z, and the machine has no setup from any of them; a stock flush with the part's bottom, or a setup "
+            "from -Z, would do");
 }
 
 TEST(ShopWords, APartWithPlansNeedsNoWords) {
