@@ -146,16 +146,7 @@ std::optional<FaceLeft> face_left_as_deposited(const PlanningProblem& problem, c
   if (std::none_of(plan.steps.begin(), plan.steps.end(), [&](const PlanStep& s) { return held(s.primitive); }))
     return std::nullopt;
   const int n = int(problem.atoms.size());
-  std::vector<int> last(std::size_t(n), -1);  // per atom: the step that changed it last
-  std::vector<std::vector<std::uint64_t>> changed(plan.steps.size());
-  AtomSet state(n), next;
-  for (std::size_t s = 0; s < plan.steps.size(); ++s) {
-    action_effect(problem, state, plan.steps[s].primitive, s == 0, next, changed[s]);
-    for (std::size_t w = 0; w < changed[s].size(); ++w)
-      for (std::uint64_t bits = changed[s][w]; bits; bits &= bits - 1)
-        last[w * 64 + std::size_t(__builtin_ctzll(bits))] = int(s);
-    state = next;
-  }
+  const auto [state, last, changed] = replay_plan(problem, plan);
   const auto laid_last = [&](int a, std::size_t s) { return last[std::size_t(a)] == int(s) && state.test(a); };
   for (std::size_t s = 0; s < plan.steps.size(); ++s) {
     const int p = plan.steps[s].primitive;

@@ -362,15 +362,9 @@ Solid plan_outcome(const PlanningResult& r, const Plan& plan) {
 }
 
 AtomSet step_region(const PlanningResult& r, const Plan& plan, std::size_t step) {
-  // Replay the plan on atom sets up to `step`, as the search applies it.
-  AtomSet state(r.atoms.atom_count()), next;
   AtomSet roi(r.atoms.atom_count());
-  std::vector<std::uint64_t> changed;
-  for (std::size_t s = 0; s <= step && s < plan.steps.size(); ++s) {
-    action_effect(r.problem, state, plan.steps[s].primitive, s == 0, next, changed);
-    if (s == step) roi.words() = changed;
-    state = next;
-  }
+  PlanReplay replay = replay_plan(r.problem, plan, step + 1);
+  if (step < replay.changed.size()) roi.words() = std::move(replay.changed[step]);
   return roi;
 }
 

@@ -97,6 +97,7 @@ struct AirWords {
   double air = 0;       // mm^3
   geometry::Vec3 at;    // mm: the middle of its air
   std::string line;     // empty: nothing certain to say
+  std::string gap;      // a narrow slot: its width and the side it opens to, which its other regions share
 };
 
 AirWords air_in_words(const config::Machine& machine, const PlanningResult& r, const ViolatingAtom& v) {
@@ -175,11 +176,13 @@ AirWords air_in_words(const config::Machine& machine, const PlanningResult& r, c
       if (w > widest) widest = w, widest_side = kDirections[k].name;
     }
   }
-  if (smallest->diameter > widest + 1e-9)
+  if (smallest->diameter > widest + 1e-9) {
+    said.gap = trimmed_number(widest, 2) + " " + widest_side;
     said.line = "narrow slot: a " + volume + " gap around " + around(at) + " is " + trimmed_number(widest, 2) +
            " mm wide at most where it opens to " + widest_side + "; the smallest cutter, " + smallest->name + " (" +
            trimmed_number(smallest->diameter, 2) + " mm), does not fit; a cutter of " + trimmed_number(widest, 2) +
            " mm or less across would do";
+  }
   // Otherwise open to a setup, and a cutter fits: what stops it is past the part's other
   // walls (shanks, holders) or in combination with other regions; the verdict's list says which.
   return said;
@@ -200,6 +203,7 @@ std::vector<std::string> refusal_in_shop_words(const config::Machine& machine, c
   int closed = 0;
   double closed_air = 0;
   geometry::Vec3 closed_at;
+  std::vector<std::string> gaps;
   for (const ViolatingAtom* v : air) {
     const AirWords said = air_in_words(machine, r, *v);
     if (said.closed) {
@@ -209,11 +213,9 @@ std::vector<std::string> refusal_in_shop_words(const config::Machine& machine, c
     }
     if (said.line.empty() || out.size() >= limit) continue;
     // The same slot's other regions (its floor, its ends) say the same thing again.
-    const auto same_gap = [&](const std::string& told) {
-      const std::size_t a = said.line.find(" mm wide at most"), b = told.find(" mm wide at most");
-      return a != std::string::npos && b != std::string::npos && said.line.substr(a) == told.substr(b);
-    };
-    if (std::none_of(out.begin(), out.end(), same_gap)) out.push_back(said.line);
+    if (!said.gap.empty() && std::find(gaps.begin(), gaps.end(), said.gap) != gaps.end()) continue;
+    if (!said.gap.empty()) gaps.push_back(said.gap);
+    out.push_back(said.line);
   }
   if (closed > 0) out[closed_line] = closed_space_words(closed_air, closed, closed_at);
   return out;

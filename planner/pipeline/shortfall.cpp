@@ -9,25 +9,6 @@ namespace hybridctl::planner {
 
 namespace {
 
-// The plan's state after `steps` actions, and per atom the step that last changed it.
-struct PlannedState {
-  AtomSet state;
-  std::vector<int> last;
-};
-
-PlannedState planned_state(const PlanningProblem& problem, int n, const Plan& plan, std::size_t steps) {
-  PlannedState out{AtomSet(n), std::vector<int>(std::size_t(n), -1)};
-  AtomSet next;
-  std::vector<std::uint64_t> changed;
-  for (std::size_t s = 0; s < std::min(steps, plan.steps.size()); ++s) {
-    action_effect(problem, out.state, plan.steps[s].primitive, s == 0, next, changed);
-    for (std::size_t w = 0; w < changed.size(); ++w)
-      for (std::uint64_t b = changed[w]; b; b &= b - 1) out.last[w * 64 + std::size_t(std::countr_zero(b))] = int(s);
-    out.state = std::move(next);
-  }
-  return out;
-}
-
 // The voxels of the domain within two voxels (each way) of a point a reason gives.
 template <typename Fn>
 void for_each_voxel_near(const AtomDecomposition& atoms, const geometry::Vec3& where, Fn fn) {
@@ -66,7 +47,7 @@ AtomFill atom_fill(const AtomDecomposition& atoms, const geometry::Solid& built)
 std::vector<Shortfall> find_shortfalls(const PlanningProblem& problem, const AtomDecomposition& atoms, const Plan& plan,
                                        std::size_t steps, const geometry::Solid& built) {
   const int n = atoms.atom_count();
-  const auto [state, last] = planned_state(problem, n, plan, steps);
+  const auto [state, last, changed] = replay_plan(problem, plan, steps);
   const auto [voxels, present] = atom_fill(atoms, built);
   const double voxel_volume = std::pow(atoms.lattice().voxel_size, 3);
   std::vector<Shortfall> out;
@@ -92,7 +73,7 @@ std::vector<Shortfall> find_missing_core_shortfalls(const PlanningProblem& probl
                                                     const Plan& plan, std::size_t steps, const geometry::Solid& missing) {
   const std::size_t executed = std::min(steps, plan.steps.size());
   const int n = atoms.atom_count();
-  const auto [state, last] = planned_state(problem, n, plan, executed);
+  const auto [state, last, changed] = replay_plan(problem, plan, executed);
   const auto removal_after = [&](int s) {
     for (std::size_t k = std::size_t(s) + 1; k < executed; ++k)
       if (problem.primitives[std::size_t(plan.steps[k].primitive)].mode == Mode::Subtractive) return true;
@@ -120,7 +101,7 @@ std::vector<Shortfall> find_skipped_layer_shortfalls(const PlanningProblem& prob
   const std::size_t executed = std::min(steps, plan.steps.size());
   if (executed < 2) return {};  // never the first action (find_shortfalls)
   const int n = atoms.atom_count();
-  const auto [state, last] = planned_state(problem, n, plan, executed);
+  const auto [state, last, changed] = replay_plan(problem, plan, executed);
   const int step = int(executed) - 1;
   const int primitive = plan.steps[std::size_t(step)].primitive;
   const PrimitiveSpec& prim = problem.primitives[std::size_t(primitive)];
@@ -150,7 +131,7 @@ std::vector<Shortfall> find_spills(const PlanningProblem& problem, const AtomDec
   }
   if (deposit < 0) return {};
   const int n = atoms.atom_count();
-  const PlannedState planned = planned_state(problem, n, plan, executed);
+  const PlanReplay planned = replay_plan(problem, plan, executed);
   const auto [voxels, present] = atom_fill(atoms, built);
   const int primitive = plan.steps[std::size_t(deposit)].primitive;
   // The atoms with material near the worst excess.

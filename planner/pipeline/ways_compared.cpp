@@ -64,19 +64,21 @@ WaysCompared compare_ways(const config::Machine& machine, const PlanningResult& 
   WaysCompared out;
   out.currency = result.currency;
   out.ways.push_back(way_of("hybrid", result));
-  config::Machine milling = machine;
-  milling.heads.clear();
-  if (machine.tools.empty()) {
-    out.ways.push_back({"milled from stock", false, {}, 0, false, 0, "the machine has no cutting tool"});
-  } else {
-    out.ways.push_back(way_of("milled from stock", plan_on(milling)));
-  }
-  config::Machine depositing = machine;
-  depositing.tools.clear();
-  if (machine.heads.empty()) {
-    out.ways.push_back({"deposited only", false, {}, 0, false, 0, "the machine has no head"});
-  } else {
-    out.ways.push_back(way_of("deposited only", plan_on(depositing)));
+  // The same machine without its heads mills from stock; without its tools it deposits only.
+  struct Other {
+    const char* name;
+    bool heads;  // keeps its heads (else its tools)
+    const char* lacking;
+  };
+  for (const Other& o : {Other{"milled from stock", false, "the machine has no cutting tool"},
+                         Other{"deposited only", true, "the machine has no head"}}) {
+    config::Machine narrowed = machine;
+    if (o.heads) narrowed.tools.clear();
+    else narrowed.heads.clear();
+    if (narrowed.heads.empty() && narrowed.tools.empty())
+      out.ways.push_back({o.name, false, {}, 0, false, 0, o.lacking});
+    else
+      out.ways.push_back(way_of(o.name, plan_on(narrowed)));
   }
   return out;
 }

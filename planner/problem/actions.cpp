@@ -63,6 +63,20 @@ void action_effect(const PlanningProblem& p, const AtomSet& state, int i, bool f
   }
 }
 
+PlanReplay replay_plan(const PlanningProblem& p, const Plan& plan, std::size_t steps) {
+  const int n = int(p.atoms.size());
+  const std::size_t taken = std::min(steps, plan.steps.size());
+  PlanReplay out{AtomSet(n), std::vector<int>(std::size_t(n), -1), std::vector<std::vector<std::uint64_t>>(taken)};
+  AtomSet next;
+  for (std::size_t s = 0; s < taken; ++s) {
+    action_effect(p, out.state, plan.steps[s].primitive, s == 0, next, out.changed[s]);
+    for (std::size_t w = 0; w < out.changed[s].size(); ++w)
+      for (std::uint64_t b = out.changed[s][w]; b; b &= b - 1) out.last[w * 64 + std::size_t(std::countr_zero(b))] = int(s);
+    out.state = std::move(next);
+  }
+  return out;
+}
+
 bool apply(const PlanningProblem& p, const AtomSet& state, int i, AtomSet& next, double& volume, bool first) {
   const PrimitiveSpec& prim = p.primitives[std::size_t(i)];
   std::vector<std::uint64_t> changed;

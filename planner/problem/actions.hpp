@@ -4,6 +4,7 @@
 // and a plan as the paper writes it. The one definition the search, the proofs, the plans'
 // regions of influence and the learning from executed candidates share.
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -19,6 +20,16 @@ namespace hybridctl::planner {
 // which works on the plate, where what failed later is not in its way.
 void action_effect(const PlanningProblem& p, const AtomSet& state, int i, bool first, AtomSet& next,
                    std::vector<std::uint64_t>& changed);
+
+// A plan replayed on atom sets with action_effect, step by step: the state after its first
+// `steps` actions (all of them by default), per atom the step that changed it last (-1:
+// none), and per step the atoms it changed (words, as AtomSet's).
+struct PlanReplay {
+  AtomSet state;
+  std::vector<int> last;
+  std::vector<std::vector<std::uint64_t>> changed;
+};
+PlanReplay replay_plan(const PlanningProblem& p, const Plan& plan, std::size_t steps = SIZE_MAX);
 
 // The state after applying primitive `i`, and the volume it really changes; false when
 // it changes nothing or cannot be taken in this state (a deposit out of the head's reach,
