@@ -74,16 +74,18 @@ int export_plan_programs(const plan::PlanFile& file, const ExportRequest& reques
     const fs::path& path = written.actions[next++];
     const gcode::CheckReport report =
         gcode::check_program(gcode::read_text_file(path), machine, path.string());
-    std::printf("  %d) %-4s %-44s %9.1f mm³  %6zu moves  %s  -> %s\n", a.step, a.primitive.c_str(),
+    std::printf("  %d) %-4s %-44s %9.1f mm³  %6zu moves  motion %s  -> %s\n", a.step, a.primitive.c_str(),
                 a.program.label.c_str(), a.program.volume, a.program.path.moves.size(),
-                gcode::format_duration(report.time.total).c_str(), path.filename().string().c_str());
+                gcode::format_duration(report.time.motion + report.time.dwell).c_str(),
+                path.filename().string().c_str());
     for (const std::string& w : a.program.path.warnings) std::printf("       warning: %s\n", w.c_str());
   }
+  const gcode::CheckReport whole = gcode::check_program(run.program.text(), machine, written.program.string());
+  std::printf("cycle time  %s: %s\n", written.program.filename().string().c_str(), whole.time.str().c_str());
   const plan::Deviation& d = run.deviation;
-  std::printf("executed    from the raw stock: %zu lines; as built %.1f mm³ over, %.1f mm³ under the design, worst "
-              "%.2f mm (tolerance %.2f mm, %s)\n",
-              run.program.lines.size(), d.over_volume, d.under_volume, d.worst_distance, file.tolerance,
-              d.within_tolerance ? "within" : "OUTSIDE");
+  std::printf("executed    from the raw stock: %zu lines; as built on the voxels %s\n", run.program.lines.size(),
+              plan::deviation_text(d, file.band()).c_str());
+  if (run.exact) std::printf("exact       %s\n", plan::exact_deviation_text(*run.exact).c_str());
   std::printf("wrote       %s, %zu action programs and tool.tbl in %s\n", written.program.filename().string().c_str(),
               written.actions.size(), request.output.c_str());
   return kSuccess;

@@ -16,8 +16,9 @@ void add_gcode_command(CLI::App& app, Runner& runner) {
       "Interpret a G-code program for a machine and report: G-code errors (file:line:column), moves outside the "
       "envelope (end points and arc extremes, machine coordinates via the setups' work_origin), tool numbers the "
       "machine lacks, deposition codes without a head selected, the spindle started with a head active, cuts with "
-      "the spindle stopped, and the estimated cycle time (trapezoidal feed and acceleration limits per axis, every "
-      "move from rest to rest). Exit 0 when clean, 3 on bad input or any problem. See docs/gcode.md.");
+      "the spindle stopped, and the cycle time with what it includes (motion: trapezoidal feed and acceleration "
+      "limits per axis, every move from rest to rest; dwells; tool changes, head switches, setup changes and "
+      "refixtures at the machine file's costs times), the one time model every command prints. Exit 0 when clean, 3 on bad input or any problem. See docs/gcode.md.");
   auto file = std::make_shared<std::string>();
   auto machine_file = std::make_shared<std::string>();
   check->add_option("FILE", *file, "G-code program (RS274NGC/LinuxCNC or Fanuc-style)")->required();

@@ -65,8 +65,8 @@ class TerminalOperator : public drivers::JobOperator {
   void started(const drivers::JobStart& job) override {
     std::printf("job         %s (program %s, %zu lines, identity %s)\n", job.job_directory.c_str(), job.program.c_str(),
                 job.lines, hex(job.identity).c_str());
-    std::printf("machine     %s via %s; estimated %s\n", job.machine.c_str(), job.transport.c_str(),
-                gcode::format_duration(job.estimated_s).c_str());
+    std::printf("machine     %s via %s\ncycle time  %s\n", job.machine.c_str(), job.transport.c_str(),
+                job.cycle_time.c_str());
     std::fflush(stdout);
     last_print_ = Clock::now() - std::chrono::seconds(10);
   }
@@ -133,7 +133,9 @@ void print_report(const drivers::JobResult& job) {
               f.x_um / 1000.0, f.y_um / 1000.0, f.z_um / 1000.0, unsigned(f.active_tool), int(f.spindle_rpm),
               f.deposition_on ? "on" : "off", f.last_executed_line, std::string(protocol::to_string(f.state)).c_str());
   for (const drivers::ActionReport& a : job.actions) {
-    const std::string time = a.seconds ? gcode::format_duration(*a.seconds) : "-";
+    // The controller's time for it as the host saw the status: the machine's real time (a
+    // simulated controller's, scaled by its --time-scale).
+    const std::string time = a.seconds ? "ran " + gcode::format_duration(*a.seconds) : "-";
     std::string alarms;
     for (std::size_t k = 0; k < a.alarms.size(); ++k)
       alarms += (k ? ", " : "  alarms ") + a.alarms[k].first +

@@ -4,6 +4,7 @@
 // trailing zeros dropped and -0 as 0 (4 digits: 0.5, 12, -0.0001). G-code words have
 // their own writer (gcode::format_number), which follows the dialect.
 
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -28,6 +29,21 @@ inline std::string trimmed_number(double v, int digits) {
     if (s.back() == '.') s.pop_back();
   }
   return s == "-0" ? "0" : s;
+}
+
+/// A duration as every cycle time is printed: "12.4 s", "3 min 12.4 s", "1 h 02 min 03 s".
+inline std::string format_duration(double seconds) {
+  char buf[64];
+  if (seconds < 60) {
+    std::snprintf(buf, sizeof buf, "%.1f s", seconds);
+  } else if (seconds < 3600) {
+    const int minutes = static_cast<int>(seconds / 60);
+    std::snprintf(buf, sizeof buf, "%d min %04.1f s", minutes, seconds - 60.0 * minutes);
+  } else {
+    const long total = std::lround(seconds);
+    std::snprintf(buf, sizeof buf, "%ld h %02ld min %02ld s", total / 3600, (total / 60) % 60, total % 60);
+  }
+  return buf;
 }
 
 }  // namespace hybridctl

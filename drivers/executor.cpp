@@ -97,15 +97,15 @@ void assemble_new_job(const JobRequest& request, Job& job, JobOperator& op) {
   job.header.transport = request.transport;
 }
 
-// The program must be clean for this machine before anything moves. Returns its
-// estimated time.
-double precheck(const std::string& name, const Job& job, JobOperator& op) {
+// The program must be clean for this machine before anything moves. Returns its cycle
+// time.
+gcode::TimeEstimate precheck(const std::string& name, const Job& job, JobOperator& op) {
   const gcode::CheckReport check = gcode::check_program(job.text, job.machine, name);
   if (!check.clean()) {
     op.check_failed(check);
     throw InputError("the program does not pass `gcode check` for machine '" + job.machine.name + "': nothing was sent");
   }
-  return check.time.total;
+  return check.time;
 }
 
 // A resumed job must still have its program; a new one gets its directory, the program
@@ -295,11 +295,11 @@ JobResult execute_job(const JobRequest& request, JobOperator& op) {
   else
     assemble_new_job(request, job, op);
   const std::uint64_t identity = protocol::program_identity(job.program.lines);
-  const double estimated_s = precheck(job.header.program.empty() ? request.input : job.header.program, job, op);
+  const gcode::TimeEstimate time = precheck(job.header.program.empty() ? request.input : job.header.program, job, op);
   open_journal(request, job, identity);
   job.record = &*job.journal;
   op.started({job.journal->file().parent_path().string(), job.header.program, job.program.lines.size(), identity,
-              job.machine.name, job.header.transport, estimated_s});
+              job.machine.name, job.header.transport, time.total, time.str()});
   return stream_job(job, op, request.wait_for_controller_s);
 }
 
@@ -313,9 +313,9 @@ JobResult execute_recorded_job(const RecordedJob& recorded, JobOperator& op) {
   job.header.transport = recorded.transport;
   job.record = recorded.record;
   const std::uint64_t identity = protocol::program_identity(job.program.lines);
-  const double estimated_s = precheck(recorded.program_name, job, op);
+  const gcode::TimeEstimate time = precheck(recorded.program_name, job, op);
   op.started({recorded.name, recorded.program_name, job.program.lines.size(), identity, job.machine.name, recorded.transport,
-              estimated_s});
+              time.total, time.str()});
   return stream_job(job, op, recorded.wait_for_controller_s);
 }
 

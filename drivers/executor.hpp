@@ -59,7 +59,8 @@ struct JobStart {
   std::uint64_t identity = 0;
   std::string machine;      ///< the machine's name
   std::string transport;    ///< URI
-  double estimated_s = 0;   ///< `gcode check`'s time estimate
+  double estimated_s = 0;   ///< the program's cycle time under `gcode check`'s model, s
+  std::string cycle_time;   ///< that time and what it includes (gcode::TimeEstimate::str)
 };
 
 /// Where the stream is, at every status read.

@@ -195,20 +195,6 @@ double motion_time(const Motion& m, const config::Envelope& envelope) {
   return trapezoid(1.0, u_speed, u_accel);
 }
 
-std::string format_duration(double seconds) {
-  char buf[64];
-  if (seconds < 60) {
-    std::snprintf(buf, sizeof buf, "%.1f s", seconds);
-  } else if (seconds < 3600) {
-    const int minutes = static_cast<int>(seconds / 60);
-    std::snprintf(buf, sizeof buf, "%d min %04.1f s", minutes, seconds - 60.0 * minutes);
-  } else {
-    const long total = std::lround(seconds);
-    std::snprintf(buf, sizeof buf, "%ld h %02ld min %02ld s", total / 3600, (total / 60) % 60, total % 60);
-  }
-  return buf;
-}
-
 namespace {
 
 /// One program's check: the report it fills, and what one line's events and motions add.
@@ -228,11 +214,49 @@ class ProgramCheck {
   std::string tool_name(int number) const;
   void unknown_tool(const Event& e);
 
+  void tool_change(int tool);
+  void work_offset(int offset);
+
   CheckReport& report_;
   const config::Machine& machine_;
   const CheckOptions& options_;
   bool warned_spindle_stopped_ = false;  // one finding per run of feed moves with the spindle stopped
+  int tool_ = 0;                         // in the spindle: 0 until the first M6
+  int work_offset_ = 0;                  // 54..59; 0 until the program selects one
 };
+
+// The changes at the machine file's costs, as the planner's estimate counts them
+// (planner/costing/costs.cpp, change_between).
+void ProgramCheck::tool_change(int tool) {
+  if (tool == tool_) return;
+  const bool head_before = machine_.find_head_by_tool(tool_) != nullptr;
+  const bool head_after = machine_.find_head_by_tool(tool) != nullptr;
+  const bool loaded_before = tool_ != 0;
+  tool_ = tool;
+  TimeEstimate& t = report_.time;
+  ++t.tool_changes;
+  t.tool_change_s += machine_.costs.tool_change;
+  if (loaded_before && head_before != head_after) {
+    ++t.head_switches;
+    t.head_switch_s += machine_.costs.head_switch;
+  }
+}
+
+void ProgramCheck::work_offset(int offset) {
+  const int before = work_offset_;
+  work_offset_ = offset;
+  if (before == 0 || before == offset) return;
+  const config::Setup* from = machine_.find_setup_by_work_offset(before);
+  const config::Setup* to = machine_.find_setup_by_work_offset(offset);
+  TimeEstimate& t = report_.time;
+  if ((from && from->manual_refixture) || (to && to->manual_refixture)) {
+    ++t.refixtures;
+    t.refixture_s += machine_.costs.refixture * 60.0;
+  } else {
+    ++t.setup_changes;
+    t.setup_change_s += machine_.costs.setup_change;
+  }
+}
 
 std::string ProgramCheck::tool_name(int number) const {
   if (const config::CuttingTool* t = machine_.find_tool(number))
@@ -256,9 +280,10 @@ void ProgramCheck::event(const Event& e, const ModalState& after) {
   const bool head_active_after = machine_.find_head_by_tool(after.tool) != nullptr;
   switch (e.kind) {
     case EventKind::ToolChange:
-      ++report_.time.tool_changes;
+      tool_change(e.tool);
       if (e.tool != 0 && !machine_.find_tool(e.tool) && !machine_.find_head_by_tool(e.tool)) unknown_tool(e);
       break;
+    case EventKind::WorkOffset: work_offset(e.index); break;
     case EventKind::DepositionOn:
       if (!head_active_after)
         finding(report_.process,
@@ -350,7 +375,10 @@ CheckReport check_program(std::string_view text, const config::Machine& machine,
     check.add_error(Finding{report.lines, 0,
                             "the program has no end; expected " + machine.gcode.m_codes.program_end +
                                 " (or M2/M30) as its last code, as LinuxCNC requires"});
-  report.time.total = report.time.feed + report.time.rapid + report.time.dwell;
+  TimeEstimate& t = report.time;
+  t.motion = t.feed + t.rapid;
+  t.changes = t.tool_change_s + t.head_switch_s + t.setup_change_s + t.refixture_s;
+  t.total = t.motion + t.dwell + t.changes;
   return report;
 }
 
@@ -373,18 +401,32 @@ std::string CheckReport::str() const {
     out += ": process: " + f.message + "\n";
   }
   if (errors_not_listed > 0) out += "... and " + std::to_string(errors_not_listed) + " more problems not listed\n";
-  out += "estimated time: " + format_duration(time.total) + " (feed " + format_duration(time.feed) + " over " +
-         fmt(time.feed_length) + " mm, rapid " + format_duration(time.rapid) + " over " + fmt(time.rapid_length) +
-         " mm, dwell " + format_duration(time.dwell) + "; every move from rest to rest";
-  if (time.program_stops > 0)
-    out += "; " + std::to_string(time.program_stops) + " program stop" + (time.program_stops == 1 ? "" : "s") +
-           " not counted";
-  if (time.tool_changes > 0)
-    out +=
-        "; " + std::to_string(time.tool_changes) + " tool change" + (time.tool_changes == 1 ? "" : "s") + " not timed";
-  out += ")\n";
+  out += "cycle time: " + time.str() + "\n";
   const int n = problems();
   out += file + ": " + (n == 0 ? std::string("clean") : std::to_string(n) + (n == 1 ? " problem" : " problems")) + "\n";
+  return out;
+}
+
+namespace {
+
+std::string counted(int n, const std::string& one, const std::string& many, double seconds) {
+  return std::to_string(n) + " " + (n == 1 ? one : many) + " " + format_duration(seconds);
+}
+
+}  // namespace
+
+std::string TimeEstimate::str() const {
+  std::string out = format_duration(total) + ": motion " + format_duration(motion) + " (feed " + format_duration(feed) +
+                    " over " + trimmed_number(feed_length, 1) + " mm, rapid " + format_duration(rapid) + " over " +
+                    trimmed_number(rapid_length, 1) + " mm; every move from rest to rest)";
+  if (dwell > 0) out += ", dwell " + format_duration(dwell);
+  if (tool_changes > 0) out += ", " + counted(tool_changes, "tool change", "tool changes", tool_change_s);
+  if (head_switches > 0) out += ", " + counted(head_switches, "head switch", "head switches", head_switch_s);
+  if (setup_changes > 0) out += ", " + counted(setup_changes, "setup change", "setup changes", setup_change_s);
+  if (refixtures > 0) out += ", " + counted(refixtures, "refixture", "refixtures", refixture_s);
+  if (program_stops > 0)
+    out += "; " + std::to_string(program_stops) + " program stop" + (program_stops == 1 ? "" : "s") +
+           " not timed (the operator's; a refixture's time holds its wait)";
   return out;
 }
 

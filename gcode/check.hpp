@@ -13,22 +13,27 @@
 //     and the spindle stopped;
 //   - the estimated cycle time (time model below).
 //
-// Time model: every motion starts and ends at rest (no blending across moves, so the
-// estimate is an upper bound for a controller that blends). Along a motion the speed
-// follows a trapezoid: constant acceleration up to the cruise speed, cruise, constant
-// deceleration. The cruise speed is the programmed feed, capped so no axis exceeds its
-// max_feed; rapids cruise at the highest speed the axes allow. The acceleration is the
+// Time model (docs/gcode.md, "The time model"): the one cycle time every print of a time
+// in hybridctl gives. Motion: every move starts and ends at rest (no blending across moves;
+// checked against LinuxCNC's trajectory planner by bench/cycle-time-vs-linuxcnc). Along a
+// move the speed follows a trapezoid: constant acceleration up to the cruise speed, cruise,
+// constant deceleration. The cruise speed is the programmed feed, capped so no axis exceeds
+// its max_feed; rapids cruise at the highest speed the axes allow. The acceleration is the
 // highest at which no axis exceeds its max_acceleration. On arcs the in-plane limits are
-// the lesser of the two plane axes' (the tangent turns through both), and the cruise
-// speed is also capped by the centripetal limit v <= sqrt(a * r). Dwells add their time;
-// program stops (M0/M1) wait for the operator and are counted, not timed; tool changes
-// take no time in this model.
+// the lesser of the two plane axes' (the tangent turns through both), and the cruise speed
+// is also capped by the centripetal limit v <= sqrt(a * r). Dwells add their time. Changes
+// take the machine file's `costs` times, as the planner's estimate counts them: an M6 to
+// another tool its tool_change, plus head_switch between a cutting tool and a head; a work
+// offset to another setup's its setup_change, or refixture when either setup is re-clamped
+// by hand (manual_refixture). Program stops (M0/M1) are counted: their wait is the
+// operator's, inside a refixture's time where one follows.
 
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "common/number_text.hpp"
 #include "config/machine.hpp"
 #include "gcode/interpreter.hpp"
 
@@ -42,14 +47,25 @@ struct Finding {
 };
 
 struct TimeEstimate {
-  double total = 0;         ///< s: feed + rapid + dwell
+  double total = 0;         ///< s: the cycle time, motion + dwell + changes
+  double motion = 0;        ///< s: feed + rapid
   double feed = 0;          ///< s in G1/G2/G3 motions
   double rapid = 0;         ///< s in G0 motions
   double dwell = 0;         ///< s in G4
+  double changes = 0;       ///< s: tool changes, head switches, setup changes and refixtures
   double feed_length = 0;   ///< mm travelled at feed (linear axes)
   double rapid_length = 0;  ///< mm travelled at rapid (linear axes)
-  int program_stops = 0;    ///< M0/M1 (operator time, not counted)
-  int tool_changes = 0;     ///< M6 (not timed)
+  int tool_changes = 0;     ///< M6 to another tool (a head is a tool)
+  int head_switches = 0;    ///< of those, between a cutting tool and a head
+  int setup_changes = 0;    ///< work offset to another setup's, neither re-clamped by hand
+  int refixtures = 0;       ///< work offset into or out of a setup re-clamped by hand
+  double tool_change_s = 0, head_switch_s = 0, setup_change_s = 0, refixture_s = 0;  ///< their seconds
+  int program_stops = 0;    ///< M0/M1 (operator time, not timed)
+
+  /// "16 min 58.7 s: motion 16 min 50.7 s (feed 16 min 23.3 s over 17533.9 mm, rapid 27.4 s
+  /// over 2252.7 mm), 1 tool change 8.0 s, 1 refixture 15 min; 1 program stop not timed":
+  /// the total and everything it includes.
+  std::string str() const;
 };
 
 struct CheckReport {
@@ -98,7 +114,7 @@ double motion_time(const Motion& m, const config::Envelope& envelope);
 /// The swept angle of an arc, radians, > 0 (2 pi for a full circle).
 double arc_sweep(const Motion& m);
 
-/// "3 min 12.4 s", "12.4 s", "1 h 02 min 03 s".
-std::string format_duration(double seconds);
+/// "3 min 12.4 s", "12.4 s", "1 h 02 min 03 s" (common/number_text.hpp).
+using hybridctl::format_duration;
 
 }  // namespace hybridctl::gcode

@@ -285,7 +285,7 @@ class Writer {
     if (!a.label.empty()) comment(a.label);
     std::string summary = "volume ";
     append_number(summary, a.volume);
-    summary += " mm3, estimated time " + format_duration(estimated_time(a, setup)) + ", " +
+    summary += " mm3, toolpath motion " + format_duration(estimated_time(a, setup)) + ", " +
                std::to_string(p.moves.size()) + " moves";
     comment(summary);
     for (const auto& w : p.warnings) comment("warning: " + w);

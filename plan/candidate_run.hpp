@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <functional>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "geometry/solid.hpp"
@@ -15,6 +16,13 @@
 #include "plan/rejection.hpp"
 
 namespace hybridctl::plan {
+
+// A program's cycle time under `gcode check`'s model (docs/gcode.md, "The time model"):
+// its seconds, and the text that says what they include.
+struct CycleTime {
+  double seconds = 0;
+  std::string text;
+};
 
 struct CandidateRun {
   // Why the plan does not make the part; none: it does (proven).
@@ -26,9 +34,12 @@ struct CandidateRun {
   std::optional<geometry::Solid> as_built;
   // The design's core is missing after the last addition, which removals cannot put back.
   bool missing_after_last_addition = false;
-  // A proven plan: each action's cycle time in minutes as `gcode check` estimates it from
-  // the action's own program (0 for one that makes no G-code); empty otherwise.
+  // A proven plan: each action's minutes of motion and dwell in its own program under
+  // `gcode check`'s model (0 for one that makes no G-code; the changes are the plan's);
+  // empty otherwise.
   std::vector<double> action_minutes;
+  // A proven plan: its whole program's cycle time, changes included.
+  std::optional<CycleTime> cycle_time;
   // The part it makes against the design's real surface, when executed to its end (none:
   // the design has no real surface, as a design made on voxels, or the plan failed before).
   std::optional<ExactDeviation> exact;
@@ -37,5 +48,17 @@ struct CandidateRun {
 
 // Executes a candidate of `file` (its rank is 0: not an offered plan yet).
 using CandidateExecutor = std::function<CandidateRun(const PlanFile& file, const PlanFilePlan& candidate)>;
+
+// The reasons the executor would turn a candidate down for without executing it (it
+// repeats what candidates executed before showed); none: it would be executed.
+using KnownRejection =
+    std::function<std::optional<std::vector<RejectionReason>>(const PlanFile& file, const PlanFilePlan& candidate)>;
+
+// An executor and what it already knows, asked first so that a candidate known to fail is
+// passed over without being executed or counted as a rejection.
+struct CandidateValidator {
+  CandidateExecutor execute;
+  KnownRejection known;
+};
 
 }  // namespace hybridctl::plan

@@ -251,7 +251,10 @@ class Gatherer {
         ++data_.actions;
       }
       entry["actions"] = actions;
-      entry["cycle_s"] = cycle;
+      // The plan's program's cycle time, changes included, as `plan` measured it; else its
+      // actions' motion.
+      const json cycle_time = field(entry, "cycle_time", json());
+      entry["cycle_s"] = cycle_time.is_object() && cycle_time.contains("seconds") ? cycle_time["seconds"] : json(cycle);
       data_.plans.push_back(PlanView{{}, paths.actions, std::nullopt});
       out.push_back(std::move(entry));
     }

@@ -114,9 +114,11 @@ ActionPath action_path(const toolpaths::ExportedAction& exported, const config::
     builder.move(at, m);
     at = m.to;
   }
-  // The time model is the one `gcode check` and `export` print: the action's own program.
+  // The time model is the one `gcode check` and `export` print: the action's own program's
+  // motion and dwell, as `plan` and `export` print it per action (the changes are the plan's).
   const std::string text = gcode::write_action(program, machine);
-  path.cycle_s = gcode::check_program(text, machine, "action " + std::to_string(path.step)).time.total;
+  const gcode::TimeEstimate time = gcode::check_program(text, machine, "action " + std::to_string(path.step)).time;
+  path.cycle_s = time.motion + time.dwell;
   return path;
 }
 

@@ -5,6 +5,7 @@
 #include <memory>
 #include <utility>
 #include <optional>
+#include <set>
 
 #include "common/error.hpp"
 #include "common/number_text.hpp"
@@ -106,8 +107,8 @@ plan::CandidateRun repeated(const ExactFailure& f) {
   return known;
 }
 
-// Minutes per action of an execution that ran to its end: each action's own program under
-// the time model of `gcode check`.
+// Minutes per action of an execution that ran to its end: the motion and dwell of each
+// action's own program under the time model of `gcode check` (its changes are the plan's).
 std::vector<double> action_minutes(const Execution& run, const config::Machine& machine) {
   std::vector<double> minutes;
   for (const toolpaths::ExportedAction& a : run.exported.actions) {
@@ -116,14 +117,15 @@ std::vector<double> action_minutes(const Execution& run, const config::Machine& 
       continue;
     }
     const std::string text = gcode::write_action(a.program, machine);
-    minutes.push_back(gcode::check_program(text, machine, a.primitive).time.total / 60.0);
+    const gcode::TimeEstimate time = gcode::check_program(text, machine, a.primitive).time;
+    minutes.push_back((time.motion + time.dwell) / 60.0);
   }
   return minutes;
 }
 
 }  // namespace
 
-plan::CandidateExecutor plan_validator(const config::Machine& machine, ExecutionOptions options,
+plan::CandidateValidator plan_validator(const config::Machine& machine, ExecutionOptions options,
                                        std::shared_ptr<PrefixCache> cache) {
   struct State {
     ExecutionOptions options;
@@ -146,6 +148,7 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
     // past a few failures, every other one is too.
     std::vector<ExactFailure> exact_failed;
     int exact_failures = 0;
+    std::set<int> tried;  // the primitives of the candidates those failures came from
     bool exact_passed = false;
     double closest_mm = 0;
   };
@@ -154,7 +157,9 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
   auto state = std::make_shared<State>();
   state->options = std::move(options);
   state->cache = cache ? std::move(cache) : std::make_shared<PrefixCache>();
-  return [&machine, state](const plan::PlanFile& file, const plan::PlanFilePlan& candidate) {
+  // The reasons a candidate is turned down for unexecuted, if any.
+  auto known = [state](const plan::PlanFile& file,
+                       const plan::PlanFilePlan& candidate) -> std::optional<std::vector<plan::RejectionReason>> {
     const auto removes = [&](const plan::PlanFileAction& a) {
       return file.primitives.at(std::size_t(a.primitive)).mode == config::Mode::Subtractive;
     };
@@ -163,22 +168,32 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
           std::equal(failed.primitives.begin(), failed.primitives.end(), candidate.actions.begin(),
                      [](int p, const plan::PlanFileAction& a) { return p == a.primitive; }) &&
           (!failed.only_if_removals_follow ||
-           std::all_of(candidate.actions.begin() + std::ptrdiff_t(failed.primitives.size()), candidate.actions.end(), removes))) {
-        plan::CandidateRun known;
-        known.reasons = failed.reasons;
-        return known;
-      }
+           std::all_of(candidate.actions.begin() + std::ptrdiff_t(failed.primitives.size()), candidate.actions.end(), removes)))
+        return failed.reasons;
     for (const ExactFailure& f : state->exact_failed)
-      if (repeats(f, file, candidate)) return repeated(f);
-    if (!state->exact_passed && state->exact_failures >= kExactFailuresBeforeGivingUp) {
-      plan::CandidateRun skipped;
-      skipped.reasons = {{"not_verified", 0, 0,
-                          "not executed: the " + std::to_string(state->exact_failures) +
-                              " cheaper candidates that made the part on the voxels all left it beyond the tolerance "
-                              "against the STL (the closest by " + fixed_number(state->closest_mm, 3) +
-                              " mm): faces need finishing passes, or a looser tolerance (docs/verification.md)",
-                          std::nullopt}};
-      return skipped;
+      if (repeats(f, file, candidate)) return repeated(f).reasons;
+    return std::nullopt;
+  };
+  auto execute = [&machine, state, known](const plan::PlanFile& file, const plan::PlanFilePlan& candidate) {
+    plan::CandidateRun unexecuted;
+    if (std::optional<std::vector<plan::RejectionReason>> reasons = known(file, candidate)) {
+      unexecuted.reasons = std::move(*reasons);
+      return unexecuted;
+    }
+    // Past a few failures against the STL and none passing, a candidate is executed only
+    // when it brings a primitive none of them had (another tool, another setup): one
+    // judged, not known, to fail, so it counts as a rejection.
+    const bool tried = std::all_of(candidate.actions.begin(), candidate.actions.end(),
+                                   [&](const plan::PlanFileAction& a) { return state->tried.count(a.primitive) > 0; });
+    if (!state->exact_passed && state->exact_failures >= kExactFailuresBeforeGivingUp && tried) {
+      unexecuted.reasons = {{"not_verified", 0, 0,
+                             "not executed: the " + std::to_string(state->exact_failures) +
+                                 " cheaper candidates that made the part on the voxels all left it beyond the "
+                                 "tolerance against the STL (the closest by " + fixed_number(state->closest_mm, 3) +
+                                 " mm), and this one has no primitive they did not: faces need finishing passes, or "
+                                 "a looser tolerance (docs/verification.md)",
+                             std::nullopt}};
+      return unexecuted;
     }
     try {
       Execution run = execute_plan(file, candidate, machine, state->options, state->cache.get());
@@ -196,6 +211,7 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
             const double off = std::max(run.exact->excess.mm, run.exact->gouge.mm);
             state->closest_mm = state->exact_failures == 0 ? off : std::min(state->closest_mm, off);
             ++state->exact_failures;
+            for (const plan::PlanFileAction& a : candidate.actions) state->tried.insert(a.primitive);
           }
           if (std::optional<ExactFailure> f = failure_of(file, candidate, *run.exact)) state->exact_failed.push_back(*f);
         }
@@ -208,6 +224,8 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
       plan::CandidateRun out;
       if (run.proven()) {
         if (run.exported.actions.size() == candidate.actions.size()) out.action_minutes = action_minutes(run, machine);
+        const gcode::TimeEstimate time = gcode::check_program(run.program.text(), machine, "plan").time;
+        out.cycle_time = plan::CycleTime{time.total, time.str()};
         out.exact = run.exact;
         return out;
       }
@@ -225,6 +243,7 @@ plan::CandidateExecutor plan_validator(const config::Machine& machine, Execution
       return unwritable;
     }
   };
+  return {execute, known};
 }
 
 }  // namespace hybridctl::validation

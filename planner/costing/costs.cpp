@@ -67,7 +67,10 @@ PlanEstimate estimate_plan(const config::Machine& m, const std::vector<Primitive
     const Primitive& p = primitives[std::size_t(step.primitive)];
     const Estimate rate = per_mm3(m, p);
     Estimate s{rate.minutes * step.volume, rate.money * step.volume};
-    const Estimate change = previous ? change_between(m, *previous, p) : Estimate{};
+    // After the raw stock, as at the start, no change: the stock is clamped in the first
+    // action's setup with its instrument loaded (planner/problem/actions.hpp, fixed_cost).
+    const Estimate change =
+        previous && previous->kind != PrimitiveKind::RawStock ? change_between(m, *previous, p) : Estimate{};
     s += change;
     e.steps.push_back(s);
     e.changes.push_back(change);

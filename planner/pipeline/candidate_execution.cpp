@@ -45,30 +45,40 @@ CandidateCheck learn_from_run(const PlanningResult& r, const Plan& plan, const p
   return check;
 }
 
-void validate_by_execution(PlanningOptions& options, plan::CandidateExecutor execute, const std::string& machine_name) {
+void validate_by_execution(PlanningOptions& options, plan::CandidateValidator validator, const std::string& machine_name) {
   struct State {
-    plan::CandidateExecutor execute;
+    plan::CandidateValidator validator;
     std::string machine_name;
     std::optional<plan::PlanFile> file;    // the planning result's grid, design and primitives
     std::optional<geometry::Solid> core;   // the design's core (plan::spared_by_cuts), once
     // Per proven candidate (its primitives in order), each action's cycle time in minutes.
     std::map<std::vector<int>, std::vector<double>> minutes;
     std::map<std::vector<int>, plan::ExactDeviation> exact;  // and its exact deviation
+    std::map<std::vector<int>, plan::CycleTime> cycle_times;  // and its program's cycle time
   };
   auto state = std::make_shared<State>();
-  state->execute = std::move(execute);
+  state->validator = std::move(validator);
   state->machine_name = machine_name;
-  options.validate = [state](const PlanningResult& r, const Plan& plan) {
+  const auto file_of = [state](const PlanningResult& r) -> const plan::PlanFile& {
     if (!state->file) {
       // No plans yet: only the grid, the design and the primitives are taken.
       const ReportSources sources{"", "", state->machine_name, ""};
       state->file = to_plan_file(r, sources, ".");
     }
-    plan::CandidateRun run = state->execute(*state->file, candidate_plan(r, plan));
+    return *state->file;
+  };
+  if (state->validator.known)
+    options.known_failure = [state, file_of](const PlanningResult& r, const Plan& plan) {
+      return state->validator.known(file_of(r), candidate_plan(r, plan)).has_value();
+    };
+  options.validate = [state, file_of](const PlanningResult& r, const Plan& plan) {
+    const plan::PlanFile& file = file_of(r);
+    plan::CandidateRun run = state->validator.execute(file, candidate_plan(r, plan));
     if (run.proven()) {
       std::vector<int> key;
       for (const PlanStep& s : plan.steps) key.push_back(s.primitive);
       if (!run.action_minutes.empty()) state->minutes[key] = run.action_minutes;
+      if (run.cycle_time) state->cycle_times[key] = *run.cycle_time;
       if (run.exact) state->exact[key] = *run.exact;
     }
     return learn_from_run(r, plan, *state->file, std::move(run), state->core);
@@ -78,6 +88,13 @@ void validate_by_execution(PlanningOptions& options, plan::CandidateExecutor exe
     for (const PlanStep& s : plan.steps) key.push_back(s.primitive);
     const auto it = state->minutes.find(key);
     return it == state->minutes.end() ? std::vector<double>{} : it->second;
+  };
+  options.cycle_time = [state](const Plan& plan) -> std::optional<plan::CycleTime> {
+    std::vector<int> key;
+    for (const PlanStep& s : plan.steps) key.push_back(s.primitive);
+    const auto it = state->cycle_times.find(key);
+    if (it == state->cycle_times.end()) return std::nullopt;
+    return it->second;
   };
   options.exact_deviation = [state](const Plan& plan) -> std::optional<plan::ExactDeviation> {
     std::vector<int> key;

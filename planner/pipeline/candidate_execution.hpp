@@ -15,12 +15,14 @@ namespace hybridctl::planner {
 // One candidate of a planning result as the plan file names it (rank 0).
 plan::PlanFilePlan candidate_plan(const PlanningResult& result, const Plan& plan);
 
-// Sets options.validate, and options.toolpath_minutes to the cycle times `execute` gave the
-// plans it proved (which rank the offered plans where the estimate is far off,
-// docs/costs.md). The planning result is turned into a plan file (to_plan_file, named
-// `machine_name`) once, at the first candidate: the grid, the design and the primitives do
-// not change after that.
-void validate_by_execution(PlanningOptions& options, plan::CandidateExecutor execute, const std::string& machine_name);
+// Sets options.validate from `validator.execute`, options.known_failure from
+// `validator.known` (candidates it would turn down unexecuted are passed over uncounted),
+// and options.toolpath_minutes, cycle_time and exact_deviation to what it gave the plans it
+// proved (the times rank the offered plans where the estimate is far off, docs/costs.md).
+// The planning result is turned into a plan file (to_plan_file, named `machine_name`)
+// once, at the first candidate: the grid, the design and the primitives do not change
+// after that.
+void validate_by_execution(PlanningOptions& options, plan::CandidateValidator validator, const std::string& machine_name);
 
 // What a run of `plan` showed it fell short on or spilled onto, as validation's hook
 // reports it: no shortfalls for a run with no material (nothing ran).

@@ -119,14 +119,15 @@ std::string objective_text(const PlanningResult& r) {
          "volume; estimates from the rates in the costs section or their defaults (docs/costs.md)";
 }
 
-// A plan's toolpath minutes with the changes between actions as the estimate has them;
-// null when not known.
+// A plan's program's cycle time in minutes, changes included; null when not known.
 json toolpath_total(const PlanningResult& r, std::size_t k) {
-  if (k >= r.toolpath_minutes.size() || r.toolpath_minutes[k].empty() || k >= r.estimates.size()) return nullptr;
-  double total = 0;
-  for (double m : r.toolpath_minutes[k]) total += m;
-  for (const Estimate& change : r.estimates[k].changes) total += change.minutes;
-  return total;
+  if (k >= r.cycle_times.size() || !r.cycle_times[k]) return nullptr;
+  return r.cycle_times[k]->seconds / 60.0;
+}
+
+json cycle_time_json(const PlanningResult& r, std::size_t k) {
+  if (k >= r.cycle_times.size() || !r.cycle_times[k]) return nullptr;
+  return {{"seconds", r.cycle_times[k]->seconds}, {"includes", r.cycle_times[k]->text}};
 }
 
 // A plan's rank in the search's order (0 = first): its place unless the toolpaths re-ranked.
@@ -280,7 +281,8 @@ std::string rejected_summary(const PlanningResult& r) {
        << (i + 1 == by_kind.size() ? ")" : "");
   const std::int64_t repeating = r.search.known_to_fail - r.faces.passed_over;
   if (repeating > 0)
-    os << "; " << repeating << " more passed over unexecuted: they begin with the actions a rejected one failed in";
+    os << "; " << repeating << " more passed over unexecuted: they begin with the actions a rejected one failed in, or repeat a "
+                                 "failure against the STL executed before";
   os << "\n";
   if (!r.learned.empty()) os << "learned     " << learned_text(r) << "\n";
   // One line each for the cheapest: the expression, the cost and the first reason, short; a
@@ -294,7 +296,7 @@ std::string rejected_summary(const PlanningResult& r) {
       os << "  ... and " << r.rejected.size() - kShown << " more candidates in plan.json\n";
       break;
     }
-    os << "  x " << expression(r.problem, candidate.plan) << "  cost " << fixed(candidate.plan.cost, 4);
+    os << "  x " << expression(r.problem, candidate.plan) << "  cost " << cost_text(r, candidate.plan.cost);
     if (candidate.reasons.empty()) {
       os << "\n";
       continue;
@@ -350,6 +352,7 @@ json plans_json(const PlanningResult& r) {
                      {"cost", plan.cost},
                      {"estimate", estimate_json(estimate.total)},
                      {"toolpath_minutes", toolpath_total(r, k)},
+                     {"cycle_time", cycle_time_json(r, k)},
                      {"optimality", optimality(plan, search_rank(r, k))},
                      {"search_rank", search_rank(r, k) + 1},
                      {"found_by", plan.exact      ? "exact-search"
@@ -621,9 +624,9 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
       os << "\n";
       os << "     estimate: " << duration_text(estimate.total.minutes) << " of machine time, "
          << money_text(estimate.total.money, r.currency);
-      const json toolpaths = toolpath_total(r, k);
-      if (!toolpaths.is_null()) os << "; toolpaths " << duration_text(toolpaths.get<double>());
-      os << "\n";
+      os << " (volumes at the rates, changes as the search counts them)\n";
+      if (k < r.cycle_times.size() && r.cycle_times[k])
+        os << "     cycle time: " << r.cycle_times[k]->text << " (its program, as export writes it)\n";
       os << "     deviation: " << plan::deviation_text(d, r.band) << " (voxels)\n";
       if (k < r.exact_deviations.size() && r.exact_deviations[k])
         os << "     exact:     " << plan::exact_deviation_text(*r.exact_deviations[k]) << "\n";
@@ -633,8 +636,7 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
         const Estimate e = s < estimate.steps.size() ? estimate.steps[s] : Estimate{};
         std::string toolpath;
         if (k < r.toolpath_minutes.size() && s < r.toolpath_minutes[k].size() && p.kind != PrimitiveKind::RawStock)
-          toolpath = "; toolpath " + duration_text(r.toolpath_minutes[k][s] +
-                                                   (s < estimate.changes.size() ? estimate.changes[s].minutes : 0.0));
+          toolpath = "; motion " + format_duration(r.toolpath_minutes[k][s] * 60.0);
         char line[360];
         std::snprintf(line, sizeof line, "     %zu) %-4s %-58s %s %10.1f mm\u00B3  cost %s  (%s, %s%s)\n", s + 1,
                       p.name.c_str(), p.label.c_str(), p.mode == Mode::Additive ? "deposit" : "remove ", st.volume,

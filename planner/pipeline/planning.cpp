@@ -348,6 +348,7 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
     r.deviations.push_back(plan::measure_deviation(plan_outcome(r, plan), r.design, r.domain, r.band));
     r.estimates.push_back(estimate_plan(machine, r.primitives, plan));
     if (options.toolpath_minutes) r.toolpath_minutes.push_back(options.toolpath_minutes(plan));
+    r.cycle_times.push_back(options.cycle_time ? options.cycle_time(plan) : std::nullopt);
     r.exact_deviations.push_back(options.exact_deviation ? options.exact_deviation(plan) : std::nullopt);
   }
   rank_by_toolpaths(machine, r);

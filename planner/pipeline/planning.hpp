@@ -15,6 +15,7 @@
 #include "planner/atoms/fine_graining.hpp"
 #include "planner/atoms/check.hpp"
 #include "planner/costing/costs.hpp"
+#include "plan/candidate_run.hpp"
 #include "plan/deviation.hpp"
 #include "planner/primitives/machine_primitives.hpp"
 #include "plan/rejection.hpp"
@@ -79,10 +80,16 @@ struct PlanningOptions {
   // atom out of its primitive, and the search starts again on the corrected problem, at
   // most kMaxLearningRounds times.
   std::function<CandidateCheck(const PlanningResult&, const Plan&)> validate;
+  // Asked before `validate`: a candidate it would turn down without executing it (it
+  // repeats a failure executed before), which the search passes over uncounted.
+  std::function<bool(const PlanningResult&, const Plan&)> known_failure;
   // After the search: an offered plan's actions' cycle times in minutes from their
   // toolpaths (validation records them as it proves plans; empty: unknown). Where they
   // are far from the estimate the plans are ranked by them (planner/costing/toolpath_rank.hpp).
   std::function<std::vector<double>(const Plan&)> toolpath_minutes;
+  // After the search: an offered plan's whole program's cycle time (validation records it
+  // as it proves plans; none: unknown).
+  std::function<std::optional<plan::CycleTime>(const Plan&)> cycle_time;
   // After the search: an offered plan's part measured against the design's real surface
   // (validation records it as it proves plans; none: not verified exactly).
   std::function<std::optional<plan::ExactDeviation>(const Plan&)> exact_deviation;
@@ -110,8 +117,8 @@ struct PlanningResult {
   std::vector<AtomMeasures> measures;
   PlanningProblem problem;
   Verdict verdict;
-  // A refusal's regions of air in a shop's words (planner/pipeline/shop_words.hpp); empty
-  // for a part with plans.
+  // A refusal's located regions in a shop's words (planner/pipeline/shop_words.hpp): its
+  // air, and design no head builds over an overhang; empty for a part with plans.
   std::vector<std::string> in_shop_words;
   std::vector<Plan> plans;
   std::vector<plan::Deviation> deviations;  // one per plan: its outcome against the design, on the voxels
@@ -142,9 +149,11 @@ struct PlanningResult {
   config::Objective objective = config::Objective::CostFactor;
   std::vector<PlanEstimate> estimates;  // one per plan
   std::string currency;
-  // Per plan, per action: the toolpath's cycle time in minutes (empty: not known), and
-  // whether the plans were ranked by them because some estimate was far off.
+  // Per plan, per action: the minutes of motion and dwell of its program (empty: not
+  // known), and whether the plans were ranked by them because some estimate was far off.
   std::vector<std::vector<double>> toolpath_minutes;
+  // Per plan: its whole program's cycle time, changes included (none: not known).
+  std::vector<std::optional<plan::CycleTime>> cycle_times;
   bool ranked_by_toolpaths = false;
   int estimates_off = 0;  // actions whose estimate is more than kEstimateTolerance off their toolpath's time
   std::vector<std::size_t> search_rank;  // per plan: its rank (0 = first) in the search's order

@@ -25,6 +25,7 @@ void rank_by_toolpaths(const config::Machine& machine, PlanningResult& r) {
   permute(r.exact_deviations);
   permute(r.estimates);
   permute(r.toolpath_minutes);
+  permute(r.cycle_times);
   permute(r.search_rank);
   permute(r.toolpath_costs);
 }

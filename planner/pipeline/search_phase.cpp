@@ -72,10 +72,11 @@ std::function<bool(const Plan&)> accept_hook(const PlanningOptions& options, Pla
 //
 // And plans that leave a face as deposited where the rule of deposited faces forbids it
 // (planner/pipeline/deposited_faces.hpp), validated or not: their parts are known to come
-// out beyond the tolerance there.
+// out beyond the tolerance there. And those validation knows to fail unexecuted
+// (PlanningOptions::known_failure: a failure against the STL they repeat).
 std::function<bool(const Plan&)> known_failure_hook(const PlanningOptions& options, PlanningResult& r) {
   const bool validated = bool(options.validate);
-  return [&r, validated](const Plan& plan) {
+  return [&options, &r, validated](const Plan& plan) {
     if (const std::optional<FaceLeft> left = face_left_as_deposited(r.problem, r.faces, plan)) {
       if (r.faces.passed_over++ == 0) r.faces.first_passed = describe_face_left(r.problem, r.faces, r.measures, plan, *left);
       return true;
@@ -95,7 +96,7 @@ std::function<bool(const Plan&)> known_failure_hook(const PlanningOptions& optio
                        [](const PlanStep& a, const PlanStep& b) { return a.primitive == b.primitive; }))
           return true;
       }
-    return false;
+    return options.known_failure && options.known_failure(r, plan);
   };
 }
 

@@ -44,12 +44,9 @@ WayOfMaking way_of(const std::string& name, const PlanningResult& r) {
   way.plan = plan_in_words(r, r.plans.front());
   const PlanEstimate& estimate = r.estimates.front();
   way.minutes = estimate.total.minutes;
-  if (!r.toolpath_minutes.empty() && !r.toolpath_minutes.front().empty()) {
-    double total = 0;
-    for (const double m : r.toolpath_minutes.front()) total += m;
-    for (const Estimate& change : estimate.changes) total += change.minutes;
-    way.minutes = total;
-    way.toolpath_minutes = true;
+  if (!r.cycle_times.empty() && r.cycle_times.front()) {
+    way.minutes = r.cycle_times.front()->seconds / 60.0;
+    way.cycle_time = true;
   }
   way.money = r.objective == config::Objective::Money
                   ? (r.ranked_by_toolpaths && !r.toolpath_costs.empty() ? r.toolpath_costs.front() : r.plans.front().cost)
@@ -84,13 +81,13 @@ WaysCompared compare_ways(const config::Machine& machine, const PlanningResult& 
 }
 
 std::string ways_compared_text(const WaysCompared& c) {
-  std::string out = "compare     each way of making the part on this machine, its best plan (machine time from the "
-                    "toolpaths where known; money as the plans are ranked):\n";
+  std::string out = "compare     each way of making the part on this machine, its best plan (machine time: its "
+                    "program's cycle time, changes included, where known; money as the plans are ranked):\n";
   char line[512];
   for (const WayOfMaking& w : c.ways) {
     if (w.planned)
-      std::snprintf(line, sizeof line, "              %-18s %-46s %12s  %s\n", w.name.c_str(), w.plan.c_str(),
-                    duration_text(w.minutes).c_str(), money_text(w.money, c.currency).c_str());
+      std::snprintf(line, sizeof line, "              %-18s %-46s %16s  %s\n", w.name.c_str(), w.plan.c_str(),
+                    (w.cycle_time ? format_duration(w.minutes * 60.0) : duration_text(w.minutes) + " est.").c_str(), money_text(w.money, c.currency).c_str());
     else
       std::snprintf(line, sizeof line, "              %-18s %s\n", w.name.c_str(), w.why_not.c_str());
     out += line;

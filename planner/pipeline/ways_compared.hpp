@@ -17,8 +17,8 @@ struct WayOfMaking {
   std::string name;            // "hybrid", "milled from stock", "deposited only"
   bool planned = false;        // a plan was offered
   std::string plan;            // its steps in words: "stock plate-12, 1 deposit, 2 removals"
-  double minutes = 0;          // its machine time: the toolpaths' where known, else the estimate
-  bool toolpath_minutes = false;
+  double minutes = 0;          // its machine time: its program's cycle time where known, else the estimate
+  bool cycle_time = false;     // `minutes` is its program's cycle time
   double money = 0;            // its money, as the plans are ranked (the toolpaths' times where they ranked them)
   std::string why_not;         // no plan: the machine lacks the means, or the verdict in short
 };

@@ -89,7 +89,9 @@ bool apply(const PlanningProblem& p, const AtomSet& state, int i, AtomSet& next,
 }
 
 double fixed_cost(const PlanningProblem& p, int previous, int next) {
-  if (previous < 0) return 0;
+  // The raw stock is clamped in the setup the first action takes, with its instrument
+  // loaded: as at the start of a plan without a stock, no change is due.
+  if (previous < 0 || p.primitives[std::size_t(previous)].raw_stock) return 0;
   const PrimitiveSpec& a = p.primitives[std::size_t(previous)];
   const PrimitiveSpec& b = p.primitives[std::size_t(next)];
   double c = 0;

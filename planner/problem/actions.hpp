@@ -36,7 +36,8 @@ PlanReplay replay_plan(const PlanningProblem& p, const Plan& plan, std::size_t s
 // or with nothing to carry its first layer). `first`: the plan's first action (on the plate).
 bool apply(const PlanningProblem& p, const AtomSet& state, int i, AtomSet& next, double& volume, bool first);
 
-// The fixed costs of `next` after `previous` (-1: `next` starts the plan), not normalised.
+// The fixed costs of `next` after `previous` (-1: `next` starts the plan), not normalised;
+// none after a raw stock, which is clamped in the setup `next` takes.
 double fixed_cost(const PlanningProblem& p, int previous, int next);
 
 // The plan that takes these steps from the empty state, with each step's volume and cost;

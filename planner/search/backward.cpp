@@ -34,6 +34,7 @@ BackwardSearch::BackwardSearch(const PlanningProblem& p, const SearchOptions& o,
   for (const PrimitiveSpec& prim : p.primitives) {
     adds_.push_back(prim.mode == Mode::Additive);
     rate_.push_back(prim.cost_per_mm3);
+    any_raw_stock_ = any_raw_stock_ || prim.raw_stock;
   }
   for (const AtomSpec& atom : p.atoms) volume_.push_back(atom.volume);
   for (int i = 0; i < int(p.primitives.size()); ++i) {
@@ -177,7 +178,9 @@ double BackwardSearch::child_bound(int i, const View& v, const std::vector<std::
       h += volume_[a] * std::min(rate, cheapest);
     }
   if (h == kInfinity || std::isnan(h)) return kInfinity;
-  if (!adds) h += p_.fixed.mode_switch;  // the plan starts with a deposit: a switch before i
+  // Without a raw stock the plan starts with a deposit: a switch before i (a removal right
+  // after a raw stock changes nothing, planner/problem/actions.hpp, fixed_cost).
+  if (!adds && !any_raw_stock_) h += p_.fixed.mode_switch;
   return std::max(0.0, h) / p_.normaliser;
 }
 

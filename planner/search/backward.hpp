@@ -107,6 +107,7 @@ class BackwardSearch {
   std::vector<std::vector<std::uint64_t>> wrong_;  // per primitive: the atoms its mode gets wrong
   std::vector<std::vector<int>> adders_;           // per atom, cheapest first
   std::vector<char> adds_;                         // per primitive: additive
+  bool any_raw_stock_ = false;                     // some primitive is a raw stock
   std::vector<double> rate_, volume_;              // per primitive, per atom
   std::deque<Node> nodes_;
   std::priority_queue<Entry, std::vector<Entry>, Worse> open_;

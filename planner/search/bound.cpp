@@ -17,11 +17,14 @@ void for_each_bit(const std::vector<std::uint64_t>& words, F f) {
     for (std::uint64_t b = words[w]; b; b &= b - 1) f(int(w * 64 + std::size_t(std::countr_zero(b))));
 }
 
+// Each raw stock has an id of its own: no change into or out of it costs anything
+// (fixed_cost), so none is ever forced.
 std::vector<int> ids_of(const PlanningProblem& p, bool setups) {
   std::map<std::string, int> ids;
   std::vector<int> out;
-  for (const PrimitiveSpec& s : p.primitives) {
-    const std::string& key = setups ? s.setup : s.tool;
+  for (std::size_t i = 0; i < p.primitives.size(); ++i) {
+    const PrimitiveSpec& s = p.primitives[i];
+    const std::string key = s.raw_stock ? "\x01raw stock " + std::to_string(i) : setups ? s.setup : s.tool;
     out.push_back(ids.emplace(key, int(ids.size())).first->second);
   }
   return out;
@@ -568,7 +571,11 @@ void LowerBound::force(const AtomSet& state, const Rates& r, std::vector<bool>& 
 double LowerBound::fixed_part(const AtomSet& state, const Rates& r, int last) const {
   const FixedCosts& f = p_.fixed;
   if (f.mode_switch == 0 && f.tool_change == 0 && f.setup_change == 0 && f.refixture == 0) return 0;
+  // Right after a raw stock the next action comes with no change, as the first does
+  // (fixed_cost): its tool and setup are free, and so is its mode.
   const bool first = last < 0;
+  const bool after_stock = !first && p_.primitives[std::size_t(last)].raw_stock;
+  const bool fresh = first || after_stock;
   const auto& s = state.words();
   auto allowed = [&](int i) { return bool(r.allowed[std::size_t(i)]); };
   bool need_add = false, need_remove = false;
@@ -580,9 +587,16 @@ double LowerBound::fixed_part(const AtomSet& state, const Rates& r, int last) co
   bool every_adder_dirty = true;
   for (int i = 0; i < int(p_.primitives.size()); ++i)
     if (p_.primitives[std::size_t(i)].mode == Mode::Additive && allowed(i) && !dirty_[std::size_t(i)]) every_adder_dirty = false;
+  bool stock_first = false;
+  for (int i = 0; first && i < int(p_.primitives.size()); ++i) stock_first = stock_first || (p_.primitives[std::size_t(i)].raw_stock && allowed(i));
   int switches = 0;
   const bool removing = !first && p_.primitives[std::size_t(last)].mode == Mode::Subtractive;
-  if (removing) {
+  if (stock_first) {
+    switches = 0;  // a raw stock, then removals alone: no switch is due (fixed_cost)
+  } else if (after_stock) {
+    // Both modes to come, or a deposit that leaves what a removal must take: one switch.
+    switches = (need_add && (need_remove || every_adder_dirty)) ? 1 : 0;
+  } else if (removing) {
     switches = need_add ? 1 + int(every_adder_dirty) : 0;
   } else {
     switches = need_remove || ((need_add || first) && every_adder_dirty) ? 1 : 0;
@@ -590,22 +604,24 @@ double LowerBound::fixed_part(const AtomSet& state, const Rates& r, int last) co
   // Tools (setups) that some needed atom can only be changed with.
   std::vector<bool> tool_forced(tool_id_.size() + 1, false), setup_forced(setup_id_.size() + 1, false);
   force(state, r, tool_forced, setup_forced);
+  for (std::size_t i = 0; i < p_.primitives.size(); ++i)
+    if (p_.primitives[i].raw_stock) tool_forced[std::size_t(tool_id_[i])] = setup_forced[std::size_t(setup_id_[i])] = false;
   // Each forced tool other than the current one is changed to at least once; at the
   // start, the first action's tool comes free.
   auto changes = [&](const std::vector<bool>& forced, int current) {
     int n = 0;
     for (std::size_t t = 0; t < forced.size(); ++t) n += forced[t] && int(t) != current;
-    return first ? std::max(0, n - 1) : n;
+    return fresh ? std::max(0, n - 1) : n;
   };
-  const int tools = changes(tool_forced, first ? -1 : tool_id_[std::size_t(last)]);
+  const int tools = changes(tool_forced, fresh ? -1 : tool_id_[std::size_t(last)]);
   // Each forced setup other than the current one is entered at least once, at no less than
   // its entry cost; at the start the dearest entry comes free (the first action's setup
   // is one of them, or none is forced).
-  const int current = first ? -1 : setup_id_[std::size_t(last)];
+  const int current = fresh ? -1 : setup_id_[std::size_t(last)];
   double setups = 0, dearest = 0;
   for (std::size_t t = 0; t < setup_forced.size(); ++t)
     if (setup_forced[t] && int(t) != current) setups += setup_entry_[t], dearest = std::max(dearest, setup_entry_[t]);
-  if (first) setups -= dearest;
+  if (fresh) setups -= dearest;
   return f.mode_switch * switches + f.tool_change * tools + setups;
 }
 

@@ -357,7 +357,7 @@
       slider.max = Math.max(0, t.layer_z.length - 1);
       controlsBox.hidden = false;
       document.getElementById('path-summary').textContent =
-        (t.additive ? 'deposition' : 'milling') + ' with ' + t.instrument + ' · ' + t.segments + ' moves · cycle ' + duration(t.cycle_s) +
+        (t.additive ? 'deposition' : 'milling') + ' with ' + t.instrument + ' · ' + t.segments + ' moves · motion ' + duration(t.cycle_s) +
         ' · ' + fmt(t.lengths.process, 0) + ' mm ' + (t.additive ? 'deposited' : 'cut') + ', ' + fmt(t.lengths.rapid, 0) + ' mm rapid';
       setLayer(t.layer_z.length - 1);
     } else {
@@ -411,7 +411,9 @@
       const head = el('div', 'plan-head');
       head.append(el('h3', '', 'Plan ' + plan.rank), el('span', 'expr', plan.expression || ''));
       const dev = plan.deviation || {};
-      const facts = ['cost ' + fmt(plan.cost, 4), 'cycle ' + duration(plan.cycle_s), (plan.actions || []).length + ' actions',
+      const facts = ['cost ' + fmt(plan.cost, 4), (plan.cycle_time ? 'cycle time ' : 'motion ') + duration(plan.cycle_s) +
+                     (plan.cycle_time && plan.cycle_time.includes ? ' (' + plan.cycle_time.includes.replace(/^[^:]*: /, '') + ')' : ''),
+                     (plan.actions || []).length + ' actions',
                      'worst deviation on the voxels ' + fmt(dev.worst_distance, 2) + ' mm' + (dev.within_tolerance === false ? ' (beyond tolerance)' : '')];
       const exact = plan.exact_map && plan.exact_map.summary ? plan.exact_map.summary : dev.exact;
       if (exact) facts.push('exact: excess ' + fmt(exact.max_excess_mm, 3) + ' mm, gouge ' + fmt(exact.max_gouge_mm, 3) + ' mm' +

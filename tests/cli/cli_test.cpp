@@ -168,15 +168,17 @@ const std::string kMachine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/mach
 const std::string kBAxisMachine = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/machines/multitask-b-axis.yaml";
 const std::string kParts = std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/";
 
-// The B-axis machine's 66 primitives (issue 15): the bound that prices removals with the
-// design they cut proves the block milled to the bracket within a few percent of optimal
-// (with a band of a voxel, plan/planning_band.hpp, more atoms are free and the exact
-// search stops at its limit; weighted A* finds it with its gap).
+// The B-axis machine's primitives (issue 15): the bound that prices removals with the
+// design they cut proves the block milled to the bracket optimal, or within a few percent
+// of it (with a band of a voxel, plan/planning_band.hpp, more atoms are free and the exact
+// search may stop at its limit; weighted A* then finds it with its gap).
 TEST_F(Cli, TheBracketOnTheBAxisMachineIsMilledFromTheBlockWithinAProvenGap) {
   // The search alone.
   const Outcome r = run({"plan", kBracket, "--machine", kBAxisMachine, "--top", "1", "--no-validate", "-o", (dir_ / "plan").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
-  EXPECT_NE(r.out.find("% of optimal (proven)"), std::string::npos) << r.out;
+  EXPECT_TRUE(r.out.find("% of optimal (proven)") != std::string::npos ||
+              r.out.find(", proven optimal") != std::string::npos)
+      << r.out;
   // The first action is the block (P2), not a deposit finished by milling.
   const std::size_t first = r.out.find("  1. (");
   ASSERT_NE(first, std::string::npos) << r.out;
@@ -190,7 +192,7 @@ TEST_F(Cli, TheBracketOnTheBAxisMachineIsMilledFromTheBlockWithinAProvenGap) {
 TEST_F(Cli, TheOverhangOnTheBAxisMachineIsProvenImpossibleBeforeAnySearch) {
   const Outcome r = run({"plan", kParts + "overhang.stl", "--machine", kBAxisMachine, "-o", (dir_ / "plan").string()});
   EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
-  EXPECT_NE(r.out.find("verdict     NOT manufacturable: no sequence of the 66 primitives gets these"), std::string::npos)
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("\nverdict     NOT manufacturable: no sequence of the [0-9]+ primitives gets these")))
       << r.out;
   EXPECT_NE(r.out.find("(must be made), in "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("(must be left empty), in "), std::string::npos) << r.out;
@@ -213,7 +215,7 @@ TEST_F(Cli, TheTubeOnAPlateIsMilledFromTheBlockOnTheBAxisMachineAtAToleranceOfAV
   const Outcome r = run({"plan", kParts + "tube-plate.stl", "--machine", kBAxisMachine, "--tolerance", "0.5", "--no-validate"});
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("plans       3 ("), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("  1. ((((P2 \u2212 "), std::string::npos) << r.out;  // from the block
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("\n  1\\. \\(+P2 \u2212 "))) << r.out;  // from the block
   EXPECT_NE(r.out.find("proven optimal"), std::string::npos) << r.out;
 }
 
@@ -230,8 +232,9 @@ TEST_F(Cli, ALeaningWallLeftAsDepositedIsRefusedAgainstTheStlBeyondThePowderHead
   const Outcome r = run({"plan", kParts + "leaning-wall.stl", "--machine", kMachine});
   ASSERT_EQ(r.exit_code, 4) << r.err << r.out;
   EXPECT_NE(r.out.find("verdict     UNDECIDED"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find(") \u222A P3)  cost"), std::string::npos) << r.out;  // the wall deposited on the milled base
-  EXPECT_NE(r.out.find("exact_excess: action"), std::string::npos) << r.out;
+  // The wall deposited on the milled base, refused for the face it leaves as deposited.
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("\n  x [^\n]*\\) \u222A P3\\)[^\n]*  cost [0-9.]+ EUR: exact_excess: action")))
+      << r.out;
   EXPECT_NE(r.out.find("(exact verification, tolerance 0.5 mm, as deposited)"), std::string::npos) << r.out;
 }
 
@@ -328,7 +331,7 @@ TEST_F(Cli, GcodeCheckReportsACleanProgramAndExitsWithZero) {
   const Outcome r = run({"gcode", "check", file.string(), "--machine", kHybrid3Axis});
   EXPECT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_NE(r.out.find("10 lines, 4 moves (2 rapid, 1 feed, 1 arc)"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("estimated time: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("cycle time: "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("ok.ngc: clean"), std::string::npos) << r.out;
 }
 

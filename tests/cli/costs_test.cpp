@@ -88,9 +88,12 @@ TEST_F(Costs, TheObjectiveIsTheUsersAndEveryPlanCarriesItsMinutesAndMoney) {
   EXPECT_NE(json.find("\"currency\": \"EUR\""), std::string::npos);
   EXPECT_NE(json.find("\"minutes\":"), std::string::npos);
   EXPECT_NE(json.find("\"money\":"), std::string::npos);
-  // Proven by execution, each action also carries its toolpath's cycle time.
+  // Proven by execution, each action also carries its program's motion, and the plan its
+  // program's cycle time.
   EXPECT_TRUE(std::regex_search(json, std::regex("\"toolpath_minutes\": [0-9]"))) << json.substr(0, 2000);
-  EXPECT_TRUE(std::regex_search(r.out, std::regex("; toolpath [0-9]"))) << r.out;
+  EXPECT_TRUE(std::regex_search(json, std::regex("\"cycle_time\": \\{"))) << json.substr(0, 2000);
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("; motion [0-9]"))) << r.out;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("\n     cycle time: [0-9][^\n]*: motion "))) << r.out;
   const Outcome bad = run_hybridctl({"plan", kBossPlate, "--machine", kTitanium, "--objective", "cheapest"});
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("--objective"), std::string::npos) << bad.err;

@@ -18,14 +18,17 @@ using hybridctl::config::Machine;
 using hybridctl::config::parse_machine;
 
 /// X, Y: 12000 mm/min (200 mm/s), 1000 mm/s²; Z: 6000 mm/min (100 mm/s), 500 mm/s².
-/// G54 at (100, 50, 10).
+constexpr const char* kLinearAxes =
+    "name: test\n"
+    "envelope:\n"
+    "  X: {travel: [0, 400], max_feed: 12000, max_acceleration: 1000}\n"
+    "  Y: {travel: [0, 300], max_feed: 12000, max_acceleration: 1000}\n"
+    "  Z: {travel: [0, 300], max_feed: 6000, max_acceleration: 500}\n";
+
+/// Those axes and a B axis; G54 at (100, 50, 10).
 const Machine& machine() {
   static const Machine m = parse_machine(
-      "name: test\n"
-      "envelope:\n"
-      "  X: {travel: [0, 400], max_feed: 12000, max_acceleration: 1000}\n"
-      "  Y: {travel: [0, 300], max_feed: 12000, max_acceleration: 1000}\n"
-      "  Z: {travel: [0, 300], max_feed: 6000, max_acceleration: 500}\n"
+      std::string(kLinearAxes) +
       "  B: {range: [-90, 90], max_feed: 3600, max_acceleration: 360}\n"
       "heads:\n"
       "  - {name: ded, process: ded-powder, bead: {width: 1.5, height: 0.75}}\n"
@@ -56,7 +59,7 @@ TEST(Check, ACleanProgramIsClean) {
   EXPECT_EQ(r.feeds, 1);
   EXPECT_EQ(r.arcs, 1);
   EXPECT_NE(r.str().find("c.ngc: clean"), std::string::npos) << r.str();
-  EXPECT_NE(r.str().find("estimated time"), std::string::npos);
+  EXPECT_NE(r.str().find("cycle time: "), std::string::npos);
 }
 
 TEST(Check, MovesOutsideTheEnvelopeAreFoundByLine) {
@@ -170,14 +173,61 @@ TEST(CheckTime, AnArcIsItsLengthAtTheFeed) {
   EXPECT_NEAR(time_of("G0 X0 Y0 Z5", "G2 X0 Y0 I0.1 F6000"), expected, 1e-9);
 }
 
-TEST(CheckTime, DwellsCountStopsAndToolChangesDoNot) {
-  const CheckReport r = check("G4 P2.5\nM0\nT1 M6\nM2\n");
+TEST(CheckTime, DwellsCountAndProgramStopsAreTheOperators) {
+  const CheckReport r = check("G4 P2.5\nM0\nM2\n");
   EXPECT_NEAR(r.time.total, 2.5, 1e-12);
   EXPECT_EQ(r.time.program_stops, 1);
-  EXPECT_EQ(r.time.tool_changes, 1);
+  EXPECT_NE(r.time.str().find("1 program stop not timed"), std::string::npos) << r.time.str();
   EXPECT_EQ(format_duration(3725), "1 h 02 min 05 s");
   EXPECT_EQ(format_duration(75.25), "1 min 15.2 s");
   EXPECT_EQ(format_duration(4.04), "4.0 s");
+}
+
+/// The machine file's change times (its costs), as the planner's estimate counts them: a
+/// tool change 8 s, a head switch 60 s more, a setup change 10 s, a refixture 15 min.
+const Machine& machine_with_changes() {
+  static const Machine m = parse_machine(
+      std::string(kLinearAxes) +
+      "heads:\n"
+      "  - {name: ded, process: ded-powder, tool_number: 100, bead: {width: 1.5, height: 0.75}}\n"
+      "tools:\n"
+      "  - {number: 1, type: flat, diameter: 10}\n"
+      "  - {number: 2, type: ball, diameter: 6}\n"
+      "setups:\n"
+      "  - {name: top, work_offset: G54, work_origin: [100, 50, 10]}\n"
+      "  - {name: side, approach: +X, work_offset: G55, work_origin: [100, 50, 10]}\n"
+      "  - {name: bottom, approach: -Z, work_offset: G56, work_origin: [100, 50, 10], manual_refixture: true}\n"
+      "costs: {tool_change: 8, head_switch: 60, setup_change: 10, refixture: 15}\n",
+      "changes.yaml");
+  return m;
+}
+
+TEST(CheckTime, ChangesTakeTheMachineFilesTimes) {
+  // The first tool loaded is a change; the same tool again is none; T2 -> T100 is a tool
+  // change and a head switch; G54 -> G55 a setup change; G55 -> G56 (re-clamped) and back
+  // to G54 two refixtures.
+  const std::string program = "G54\nT1 M6\nT1 M6\nT2 M6\nT100 M6\nG55\nM0\nG56\nG54\nM2\n";
+  const CheckReport r = check_program(program, machine_with_changes(), "c.ngc");
+  ASSERT_TRUE(r.clean()) << r.str();
+  EXPECT_EQ(r.time.tool_changes, 3);
+  EXPECT_EQ(r.time.head_switches, 1);
+  EXPECT_EQ(r.time.setup_changes, 1);
+  EXPECT_EQ(r.time.refixtures, 2);
+  EXPECT_NEAR(r.time.total, 3 * 8 + 60 + 10 + 2 * 15 * 60, 1e-9);
+  EXPECT_NEAR(r.time.motion, 0, 1e-12);
+  EXPECT_NE(r.time.str().find("3 tool changes 24.0 s, 1 head switch 1 min 00.0 s, 1 setup change 10.0 s, 2 "
+                              "refixtures 30 min 00.0 s"),
+            std::string::npos)
+      << r.time.str();
+}
+
+TEST(CheckTime, TheCycleTimeIsMotionDwellAndChanges) {
+  const CheckReport r = check_program("G54\nT1 M6\nS1000 M3\nG0 X0 Y0 Z5\nG1 X100 F6000\nG4 P1\nM2\n",
+                                      machine_with_changes(), "c.ngc");
+  ASSERT_TRUE(r.clean()) << r.str();
+  EXPECT_NEAR(r.time.motion, r.time.feed + r.time.rapid, 1e-12);
+  EXPECT_NEAR(r.time.total, r.time.motion + 1.0 + 8.0, 1e-9);
+  EXPECT_EQ(r.time.str().rfind(format_duration(r.time.total) + ": motion ", 0), 0u) << r.time.str();
 }
 
 TEST(CheckTime, RotaryMovesUseTheRotaryLimits) {

@@ -133,7 +133,7 @@ TEST(PostRs274ngc, HeaderActionsAndEnd) {
       << text;
   EXPECT_NE(text.find("(action 2: primitive P2, subtractive milling with T1 10 mm flat rougher in setup top)"),
             std::string::npos);
-  EXPECT_NE(text.find("(volume 1234.5 mm3, estimated time "), std::string::npos);
+  EXPECT_NE(text.find("(volume 1234.5 mm3, toolpath motion "), std::string::npos);
   // Tool changes with length compensation, the spindle after the change, M5 before the head.
   EXPECT_NE(text.find("\nT100 M6\nG43 H100\nM68 E0 Q800\n"), std::string::npos) << text;
   EXPECT_NE(text.find("\nT1 M6\nG43 H1\nS8000 M3\n"), std::string::npos) << text;

@@ -141,7 +141,7 @@ INSTANTIATE_TEST_SUITE_P(Examples, ExamplePartVolume,
                                            ExamplePart{"boss-plate.stl"}, ExamplePart{"tube-plate.stl"},
                                            ExamplePart{"leaning-wall.stl"}, ExamplePart{"lidded-channel-block.stl"},
                                            ExamplePart{"bladed-disc.stl"}, ExamplePart{"gusset-bracket.stl"},
-                                           ExamplePart{"rounded-box-dimple.stl"}),
+                                           ExamplePart{"rounded-box-dimple.stl"}, ExamplePart{"chamfered-cap.stl"}),
                          [](const auto& info) {
                            std::string name = info.param.file;
                            name = name.substr(0, name.find('.'));

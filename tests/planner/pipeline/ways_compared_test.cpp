@@ -38,6 +38,7 @@ PlanningResult planned(std::vector<int> steps, double money, double minutes, dou
     r.ranked_by_toolpaths = true;
     r.toolpath_costs = {toolpath_money};
     r.toolpath_minutes = {{0, 70, 20}};
+    r.cycle_times = {plan::CycleTime{90 * 60.0, "1 h 30 min 00 s: motion 1 h 30 min 00 s"}};
   }
   return r;
 }
@@ -78,18 +79,19 @@ TEST(WaysCompared, MillsOnTheMachineWithoutItsHeadsAndDepositsOnItWithoutItsTool
   EXPECT_EQ(asked[1].heads.size(), 1u);
   EXPECT_TRUE(asked[1].tools.empty());
   ASSERT_EQ(c.ways.size(), 3u);
-  // The hybrid plan as ranked: by its toolpaths' times, which re-ranked the plans.
+  // The hybrid plan as ranked: by its toolpaths' times, which re-ranked the plans; its
+  // machine time its program's cycle time.
   EXPECT_EQ(c.ways[0].plan, "from plate-12 (plate), 1 deposit, 1 removal");
   EXPECT_DOUBLE_EQ(c.ways[0].money, 441.17);
   EXPECT_DOUBLE_EQ(c.ways[0].minutes, 90);
-  EXPECT_TRUE(c.ways[0].toolpath_minutes);
+  EXPECT_TRUE(c.ways[0].cycle_time);
   EXPECT_EQ(c.ways[1].plan, "from plate-12 (plate), 2 removals");
   EXPECT_DOUBLE_EQ(c.ways[1].money, 763.05);
   EXPECT_FALSE(c.ways[2].planned);
   EXPECT_EQ(c.ways[2].why_not, "no plan: 1 atom straddles the design");
   const std::string text = ways_compared_text(c);
   EXPECT_NE(text.find("hybrid             from plate-12 (plate), 1 deposit, 1 removal"), std::string::npos) << text;
-  EXPECT_NE(text.find("1 h 30 min  441.17 EUR"), std::string::npos) << text;
+  EXPECT_NE(text.find("1 h 30 min 00 s  441.17 EUR"), std::string::npos) << text;
   EXPECT_NE(text.find("deposited only     no plan: 1 atom straddles the design"), std::string::npos) << text;
   EXPECT_NE(text.find("the hybrid plan costs 42 % less than the best plan milled from stock"), std::string::npos) << text;
 }

@@ -60,6 +60,23 @@ std::set<std::string> expressions(const VoxelProblem& vp, const std::vector<Plan
   return out;
 }
 
+// The raw stock is clamped in the setup of the action after it, with that action's
+// instrument loaded: no change is due there, even into a setup the part is re-clamped for
+// by hand, while the same change between two actions costs the tool, the setup (a
+// refixture) and the mode.
+TEST(FixedCost, TheStepAfterARawStockCostsNoChange) {
+  PlanningProblem p;
+  p.fixed = {5.0, 3.0, 7.0, 13.0};
+  AtomSet none(1);
+  p.primitives = {spec("stock", Mode::Additive, true, 0.0, none, "", "top"),
+                  spec("deposit", Mode::Additive, false, 1.0, none, "ded", "top"),
+                  spec("mill", Mode::Subtractive, false, 1.0, none, "T1", "bottom")};
+  p.primitives[2].refixture = true;
+  EXPECT_EQ(fixed_cost(p, 0, 2), 0.0);
+  EXPECT_EQ(fixed_cost(p, -1, 2), 0.0);
+  EXPECT_EQ(fixed_cost(p, 1, 2), 5.0 + 13.0 + 7.0);
+}
+
 TEST(PaperExample, HasElevenNonEmptyAtoms) {
   const VoxelProblem vp = paper_example(false);
   EXPECT_EQ(vp.atoms.atom_count(), 11);

@@ -310,10 +310,10 @@ TEST(SimServe, TakesTheStockFromAPlan) {
   const fs::path dir = temp_dir("plan-stock");
   // --no-validate: the subject is the stock `sim serve --stock` takes from a plan's first
   // action, not whether the plan makes the part. The flanged hub's plans that pass
-  // execution all start from a raw stock; unvalidated, its 6th plan at 1 mm deposits from
-  // nothing.
+  // execution all start from a raw stock; unvalidated, one of its first plans at 1 mm
+  // deposits from nothing (the 7th, by money).
   const PeerResult plan = run_peer({HYBRIDCTL_EXE, "plan", std::string(HYBRIDCTL_SOURCE_DIR) + "/examples/parts/flanged-hub.stl",
-                                    "--machine", example_machine(), "--voxel", "1", "--top", "6", "--no-validate", "-o",
+                                    "--machine", example_machine(), "--voxel", "1", "--top", "8", "--no-validate", "-o",
                                     (dir / "plan").string()});
   ASSERT_EQ(plan.exit_code, 0) << plan.output;
   // The ranks of a plan that starts from a raw stock and of one that starts by depositing.
