@@ -54,6 +54,7 @@ struct DryRunArgs {
   std::string objective;
   double time_scale = 0;
   bool report = false;
+  bool verbose = false;
 };
 
 // `hybridctl sim serve` as a child process; killed when this goes out of scope.
@@ -233,7 +234,7 @@ int run_dry_run(const DryRunArgs& a) {
   options.objective = objective(a.objective);
   const planner::PlanningResult planned = planner::plan_part(mesh, a.part, machine, options);
   const planner::ReportSources sources{a.part, a.machine, machine.name, machine_text};
-  std::fputs(planner::plan_summary(planned, sources).c_str(), stdout);
+  std::fputs(planner::plan_summary(planned, sources, a.verbose).c_str(), stdout);
   if (!planned.verdict.manufacturable() || planned.plans.empty()) return kNotManufacturable;
   const fs::path plan_dir = out / "plan";
   planner::write_plan_directory(planned, sources, plan_dir);
@@ -286,6 +287,7 @@ void add_dry_run_command(CLI::App& app, Runner& runner) {
   add_memory_budget_option(cmd, a->memory_budget);
   cmd->add_flag("--report", a->report,
                 "Also write the job report with what the run built and its alarms, DIR/report.html and its PNG snapshots");
+  cmd->add_flag("--verbose", a->verbose, "As for `plan`: a refusal's proof in atoms and regions too");
   cmd->add_option("--stock", a->stock_files,
                   "Raw stock as a file (STL, or .vdb on the plan's voxel grid) in the part's frame, as for `plan`; "
                   "repeatable");

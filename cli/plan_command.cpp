@@ -44,6 +44,7 @@ struct PlanArgs {
   int max_rejected = 200;
   bool report = false;
   bool compare = false;
+  bool verbose = false;
 };
 
 planner::PrimitiveFile parse_primitive_argument(const std::string& arg) {
@@ -100,7 +101,7 @@ int run_plan(const PlanArgs& args) {
   const planner::PlanningResult result = planner::plan_part(mesh, args.part, machine, options);
   bar.finish();
   const planner::ReportSources sources{args.part, args.machine, machine.name, machine_text};
-  std::fputs(planner::plan_summary(result, sources).c_str(), stdout);
+  std::fputs(planner::plan_summary(result, sources, args.verbose).c_str(), stdout);
   if (args.compare) {
     ProgressBar others("comparing");
     int planned = 0;
@@ -170,6 +171,9 @@ void add_plan_command(CLI::App& app, Runner& runner) {
                 "Also plan the part milled from stock only (the machine without its heads) and deposited only "
                 "(without its tools), and print each way's best plan with its machine time and money beside the "
                 "hybrid one (docs/costs.md)");
+  cmd->add_flag("--verbose", args->verbose,
+                "A refusal's proof in atoms and regions too, where its places are said in shop words (always in "
+                "plan.json)");
   cmd->add_option("--dialect", args->dialect, "With --export: rs274ngc or fanuc (default: the machine file's)");
   cmd->add_option("--voxel", args->voxel, "Voxel size in mm (default: the machine file's planning.voxel_size)")
       ->check(greater_than(0));

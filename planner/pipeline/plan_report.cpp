@@ -543,7 +543,7 @@ void write_plan_directory(const PlanningResult& r, const ReportSources& src, con
   }
 }
 
-std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
+std::string plan_summary(const PlanningResult& r, const ReportSources& src, bool verbose) {
   std::ostringstream os;
   const geometry::IndexBox b = r.design.bounding_box();
   os << "design      " << src.part_path << ": " << fixed(r.design_volume, 1) << " mm\u00B3, " << (b.hi.x - b.lo.x) << " x "
@@ -573,15 +573,18 @@ std::string plan_summary(const PlanningResult& r, const ReportSources& src) {
        << " round" << (r.fine_graining.rounds == 1 ? "" : "s")
        << (r.fine_graining.capped ? " (stopped at the cap of " + std::to_string(kMaxFineGrainedPrimitives) + ")" : "")
        << "\n";
+  // In shop words where they can be said; the proof in atoms behind --verbose.
+  const bool in_words = !verbose && !r.in_shop_words.empty() && r.verdict.outcome != Verdict::Outcome::Manufacturable;
   os << "verdict     "
      << (r.verdict.outcome == Verdict::Outcome::Manufacturable  ? "manufacturable"
          : r.verdict.outcome == Verdict::Outcome::Undecided     ? "UNDECIDED"
                                                                 : "NOT manufacturable")
-     << ": " << r.verdict.summary
+     << (in_words ? " (in words below; the proof in atoms and regions: plan.json's verdict, or --verbose)"
+                  : ": " + r.verdict.summary)
      << "\n";
   for (std::size_t i = 0; i < r.in_shop_words.size(); ++i)
     os << (i == 0 ? "in words    " : "            ") << r.in_shop_words[i] << "\n";
-  os << violations_text(r);
+  if (!in_words) os << violations_text(r);
   os << stock_starts_text(r);
   if (r.validated) os << rejected_summary(r);
   if (r.faces.passed_over > 0)

@@ -38,7 +38,9 @@ plan::PlanFile to_plan_file(const PlanningResult& result, const ReportSources& s
 void write_plan_directory(const PlanningResult& result, const ReportSources& sources,
                           const std::filesystem::path& directory);
 
-// The summary people read on the terminal.
-std::string plan_summary(const PlanningResult& result, const ReportSources& sources);
+// The summary people read on the terminal. A refusal or UNDECIDED that can be said in
+// shop words (PlanningResult::in_shop_words) is said so, its proof in atoms and regions left
+// to plan.json unless `verbose`.
+std::string plan_summary(const PlanningResult& result, const ReportSources& sources, bool verbose = false);
 
 }  // namespace hybridctl::planner

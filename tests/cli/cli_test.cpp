@@ -207,6 +207,27 @@ TEST_F(Cli, TheOverhangOnTheBAxisMachineIsProvenImpossibleBeforeAnySearch) {
   EXPECT_NE(json.find("\"violations\": [\n"), std::string::npos);
 }
 
+// A refusal a shop can read: the lidded channel's closed space in shop words, and the
+// proof in atoms and regions (the planner's language) in plan.json and behind --verbose.
+TEST_F(Cli, ARefusalIsSaidInShopWordsWithItsProofInAtomsBehindVerbose) {
+  const Outcome r = run({"plan", kParts + "lidded-channel-block.stl", "--machine", kBAxisMachine, "-o", (dir_ / "plan").string()});
+  EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
+  EXPECT_NE(r.out.find("\nverdict     NOT manufacturable (in words below; the proof in atoms and regions: plan.json's "
+                       "verdict, or --verbose)\n"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("\nin words    closed space: a 205 mm³ cavity around "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("(must be made), in "), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("atoms right together"), std::string::npos) << r.out;
+  EXPECT_NE(slurp(dir_ / "plan" / "plan.json").find("\"violations\": [\n"), std::string::npos);
+
+  const Outcome verbose = run({"plan", kParts + "lidded-channel-block.stl", "--machine", kBAxisMachine, "--verbose"});
+  EXPECT_EQ(verbose.exit_code, 4) << verbose.err << verbose.out;
+  EXPECT_NE(verbose.out.find("\nverdict     NOT manufacturable: no sequence of the "), std::string::npos) << verbose.out;
+  EXPECT_NE(verbose.out.find("\nin words    closed space: "), std::string::npos) << verbose.out;
+  EXPECT_NE(verbose.out.find("(must be left empty), in "), std::string::npos) << verbose.out;
+}
+
 // A tube on a plate on the B-axis machine, with a tolerance of one voxel: the bore's edge
 // with the plate is a sharp concave ring whose voxels a cutter's sweep on the grid misses
 // here and there, so the atom kept clear there is one beside it that the 12 mm flat
