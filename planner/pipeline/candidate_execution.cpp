@@ -51,10 +51,19 @@ void validate_by_execution(PlanningOptions& options, plan::CandidateValidator va
     std::string machine_name;
     std::optional<plan::PlanFile> file;    // the planning result's grid, design and primitives
     std::optional<geometry::Solid> core;   // the design's core (plan::spared_by_cuts), once
-    // Per proven candidate (its primitives in order), each action's cycle time in minutes.
-    std::map<std::vector<int>, std::vector<double>> minutes;
-    std::map<std::vector<int>, plan::ExactDeviation> exact;  // and its exact deviation
-    std::map<std::vector<int>, plan::CycleTime> cycle_times;  // and its program's cycle time
+    // Per proven candidate (its primitives in order): what its run measured.
+    struct Proven {
+      std::vector<double> action_minutes;
+      std::optional<plan::CycleTime> cycle_time;
+      std::optional<plan::ExactDeviation> exact;
+    };
+    std::map<std::vector<int>, Proven> proven;
+    const Proven* proven_of(const Plan& plan) const {
+      std::vector<int> key;
+      for (const PlanStep& s : plan.steps) key.push_back(s.primitive);
+      const auto it = proven.find(key);
+      return it == proven.end() ? nullptr : &it->second;
+    }
   };
   auto state = std::make_shared<State>();
   state->validator = std::move(validator);
@@ -77,31 +86,21 @@ void validate_by_execution(PlanningOptions& options, plan::CandidateValidator va
     if (run.proven()) {
       std::vector<int> key;
       for (const PlanStep& s : plan.steps) key.push_back(s.primitive);
-      if (!run.action_minutes.empty()) state->minutes[key] = run.action_minutes;
-      if (run.cycle_time) state->cycle_times[key] = *run.cycle_time;
-      if (run.exact) state->exact[key] = *run.exact;
+      state->proven[key] = {run.action_minutes, run.cycle_time, run.exact};
     }
     return learn_from_run(r, plan, *state->file, std::move(run), state->core);
   };
   options.toolpath_minutes = [state](const Plan& plan) {
-    std::vector<int> key;
-    for (const PlanStep& s : plan.steps) key.push_back(s.primitive);
-    const auto it = state->minutes.find(key);
-    return it == state->minutes.end() ? std::vector<double>{} : it->second;
+    const State::Proven* p = state->proven_of(plan);
+    return p ? p->action_minutes : std::vector<double>{};
   };
-  options.cycle_time = [state](const Plan& plan) -> std::optional<plan::CycleTime> {
-    std::vector<int> key;
-    for (const PlanStep& s : plan.steps) key.push_back(s.primitive);
-    const auto it = state->cycle_times.find(key);
-    if (it == state->cycle_times.end()) return std::nullopt;
-    return it->second;
+  options.cycle_time = [state](const Plan& plan) {
+    const State::Proven* p = state->proven_of(plan);
+    return p ? p->cycle_time : std::nullopt;
   };
-  options.exact_deviation = [state](const Plan& plan) -> std::optional<plan::ExactDeviation> {
-    std::vector<int> key;
-    for (const PlanStep& s : plan.steps) key.push_back(s.primitive);
-    const auto it = state->exact.find(key);
-    if (it == state->exact.end()) return std::nullopt;
-    return it->second;
+  options.exact_deviation = [state](const Plan& plan) {
+    const State::Proven* p = state->proven_of(plan);
+    return p ? p->exact : std::nullopt;
   };
 }
 

@@ -285,9 +285,16 @@ TEST_F(Cli, PlansTheFlangedHubAndWritesPlanJsonWithValidPlans) {
 // far past the head's 30 degrees) and that a deposit from -Z, turned over, could only lay
 // under the material already there. The planner proves, before any search, that no order
 // of its primitives makes the roof, the hole and what carries them right together, and
-// names the roof, without offering validation a plan that must fail.
+// names the roof, without offering validation a plan that must fail. In shop words: the
+// hole can only be cut from the sides, and the machine has no setup there.
 TEST_F(Cli, TheBracketIsProvenNotManufacturableOnTheThreeAxisMachineAndTheHoleRoofIsNamed) {
-  const Outcome r = run({"plan", kBracket, "--machine", kMachine, "--voxel", "1"});
+  const Outcome words = run({"plan", kBracket, "--machine", kMachine, "--voxel", "1"});
+  EXPECT_EQ(words.exit_code, 4) << words.err << words.out;
+  EXPECT_NE(words.out.find("\nin words    a 800 mm³ region around (5.0, 20.0, 35.0) mm can only be cut from +X and -X, and "
+                           "the machine has no setup from any of them"),
+            std::string::npos)
+      << words.out;
+  const Outcome r = run({"plan", kBracket, "--machine", kMachine, "--voxel", "1", "--verbose"});
   EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
   EXPECT_NE(r.out.find("verdict     NOT manufacturable: no sequence of the 18 primitives gets these"), std::string::npos)
       << r.out;
