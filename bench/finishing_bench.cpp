@@ -30,11 +30,15 @@ using namespace hybridctl;
 int g_top_k = 0;         // plans per part: 0 as `plan` (its default); 1 for --smoke
 double g_voxel = 0.5;    // 1 for --smoke
 
-// Minutes of the plan's programs under `gcode check`'s time model.
+// Minutes of motion and dwell of the plan's action programs under `gcode check`'s time
+// model (the changes between them are the same with finishing and without).
 double cycle_minutes(const toolpaths::PlanExport& made, const config::Machine& machine) {
   double minutes = 0;
-  for (const toolpaths::ExportedAction& a : made.actions)
-    if (a.makes_gcode) minutes += gcode::check_program(gcode::write_action(a.program, machine), machine, a.primitive).time.total / 60.0;
+  for (const toolpaths::ExportedAction& a : made.actions) {
+    if (!a.makes_gcode) continue;
+    const gcode::TimeEstimate t = gcode::check_program(gcode::write_action(a.program, machine), machine, a.primitive).time;
+    minutes += (t.motion + t.dwell) / 60.0;
+  }
   return minutes;
 }
 
