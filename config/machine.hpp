@@ -209,6 +209,8 @@ struct CuttingTool {
   double plunge_feed = 300.0;           ///< mm/min, > 0
   /// mm/min of the finishing passes (walls, 3D faces), > 0; 0 in the model: not given (finishing_feed()).
   double finish_feed = 0.0;
+  /// rpm of the finishing passes, > 0; 0 in the model: not given (finishing_spindle_speed()).
+  double finish_spindle_speed = 0.0;
   double step_down = 0.0;               ///< mm, 0 < d <= flute_length; default 0.5 x diameter
   double step_over = 0.0;               ///< mm, 0 < s <= diameter; default 0.4 x diameter
   double cost_per_mm3 = 1.0;            ///< cost factor per mm³ removed, >= 0 (objective cost-factor)
@@ -225,6 +227,8 @@ struct CuttingTool {
   double volume_rate() const { return removal_rate > 0 ? removal_rate : step_down * step_over * feed; }
   /// The finishing passes' feed in force: the machine file's finish_feed, else the feed.
   double finishing_feed() const { return finish_feed > 0 ? finish_feed : feed; }
+  /// The finishing passes' spindle speed in force: finish_spindle_speed, else spindle_speed.
+  double finishing_spindle_speed() const { return finish_spindle_speed > 0 ? finish_spindle_speed : spindle_speed; }
   bool offers(PrimitiveKind k) const {
     for (auto p : primitives)
       if (p == k) return true;

@@ -272,7 +272,7 @@ std::optional<std::size_t> MachineReader::read_tools(const Value& v) {
 void MachineReader::read_tool(const Value& v) {
   MapReader r(sink_, v,
               {"number", "name", "type", "diameter", "corner_radius", "flute_length", "shank", "holder",
-               "spindle_speed", "feed", "plunge_feed", "finish_feed", "step_down", "step_over", "cost_per_mm3", "removal_rate", "wear", "primitives"});
+               "spindle_speed", "finish_spindle_speed", "feed", "plunge_feed", "finish_feed", "step_down", "step_over", "cost_per_mm3", "removal_rate", "wear", "primitives"});
   if (!r.ok()) return;
   const std::size_t before = sink_.count();
   CuttingTool t;
@@ -290,6 +290,7 @@ void MachineReader::read_tool(const Value& v) {
   if (auto f = r.find("shank")) read_tool_body(f->value, t.shank);
   if (auto f = r.find("holder")) read_tool_body(f->value, t.holder);
   number(r, "spindle_speed", kSpindleSpeed, Bound::Positive, t.spindle_speed);
+  number(r, "finish_spindle_speed", kSpindleSpeed, Bound::Positive, t.finish_spindle_speed);
   number(r, "feed", kFeed, Bound::Positive, t.feed);
   number(r, "plunge_feed", kFeed, Bound::Positive, t.plunge_feed);
   number(r, "finish_feed", kFeed, Bound::Positive, t.finish_feed);

@@ -71,7 +71,9 @@ std::string summarize(const Machine& m) {
     if (t.type == ToolType::Bull) text += " r" + fmt(t.corner_radius);
     if (t.name != "T" + std::to_string(t.number)) text += " \"" + t.name + "\"";
     text += ", flutes " + fmt(t.flute_length) + " mm, stick-out " + fmt(t.stick_out()) + " mm, " +
-            fmt(t.spindle_speed) + " rpm, feed " + fmt(t.feed) + " mm/min" +
+            fmt(t.spindle_speed) + " rpm" +
+            (t.finish_spindle_speed > 0 ? " (finishing " + fmt(t.finish_spindle_speed) + ")" : std::string()) +
+            ", feed " + fmt(t.feed) + " mm/min" +
             (t.finish_feed > 0 ? " (finishing " + fmt(t.finish_feed) + ")" : std::string()) + ", " + fmt(t.volume_rate()) + " mm³/min, " +
             primitives(t.primitives);
     out.item("T" + std::to_string(t.number), text);

@@ -363,6 +363,14 @@ class Writer {
       const PathMove& m = p.moves[k];
       origin_ = {index, static_cast<int>(k), "move"};
       if (!m.comment.empty()) comment(m.comment);
+      if (in.tool && m.kind != MoveKind::Rapid) {
+        // A pass at its own spindle speed (finishing): S before it, and back after.
+        const long rpm = std::lround(m.spindle > 0 ? m.spindle : in.tool->spindle_speed);
+        if (rpm != spindle_rpm_) {
+          line("S" + std::to_string(rpm));
+          spindle_rpm_ = rpm;
+        }
+      }
       if (in.head) {
         const bool on = m.process_on;
         if (on && !deposition_head_) {

@@ -34,6 +34,7 @@ struct PathMove {
   // statistics only: the spindle runs for the whole toolpath).
   bool process_on = false;
   std::string comment;        // optional, written as a comment before the move
+  double spindle = 0;         // rpm of a milling feed move or arc; 0: the tool's spindle_speed
 };
 
 enum class Process { Deposition, Milling };

@@ -169,7 +169,8 @@ std::vector<PathMove> fit_arcs(const Vec3& start, const std::vector<PathMove>& m
     for (std::size_t k = 1; i + k - 1 < moves.size(); ++k) {
       const PathMove& m = moves[i + k - 1];
       const bool joins = m.kind == MoveKind::Feed && std::abs(m.to.z - at.z) <= kSameHeight &&
-                         (k == 1 || (m.comment.empty() && m.feed == first.feed && m.process_on == first.process_on)) &&
+                         (k == 1 || (m.comment.empty() && m.feed == first.feed && m.spindle == first.spindle &&
+                                     m.process_on == first.process_on)) &&
                          norm(xy(m.to) - points.back()) >= kShortestChord;
       if (!joins) break;
       points.push_back(xy(m.to));
@@ -190,6 +191,7 @@ std::vector<PathMove> fit_arcs(const Vec3& start, const std::vector<PathMove>& m
     arc.to = moves[i + best_k - 1].to;
     arc.centre = {best->centre.x, best->centre.y, at.z};
     arc.feed = first.feed;
+    arc.spindle = first.spindle;
     arc.process_on = first.process_on;
     arc.comment = first.comment;
     out.push_back(std::move(arc));

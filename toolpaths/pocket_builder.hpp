@@ -199,6 +199,9 @@ class PocketBuilder {
   std::vector<int> tops_, untouchable_tops_;
   double safe_z_ = 0;
   Vec3 at_{};
+  // The spindle speed the feed moves run at from here (0: the tool's): the finishing
+  // passes run at the tool's finishing speed.
+  double spindle_ = 0;
   bool started_ = false;
   bool at_level_ = false;
   int level_ = 0;                        // the level being cut (voxel layer of the tip)

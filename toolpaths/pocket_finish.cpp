@@ -493,6 +493,7 @@ std::optional<FinishPass> PocketBuilder::finish_pass(const FinishLevel& f, const
 // material still there. The lead-in's last move and the lead-out's first carry the
 // comments: an arc is fitted to what follows a comment, never across one.
 void PocketBuilder::cut_finish_pass(const FinishLevel& f, const FinishPass& pass) {
+  spindle_ = tool_.finishing_spindle_speed();
   const Point2 here{at_.x, at_.y}, a = pass.lead_in.front();
   std::vector<Point2> swept;
   if (at_level_ && std::abs(at_.z - f.z) <= kHeightSlack && f.segment_safe(here, a)) {
@@ -515,6 +516,7 @@ void PocketBuilder::cut_finish_pass(const FinishLevel& f, const FinishPass& pass
   swept.insert(swept.end(), pass.body.begin(), pass.body.end());
   swept.insert(swept.end(), pass.lead_out.begin(), pass.lead_out.end());
   stamp_polyline(swept, f.z);
+  spindle_ = 0;
 }
 
 void PocketBuilder::finish_walls(const TipKeepOut& keep_out, int k, int k_above, double z) {

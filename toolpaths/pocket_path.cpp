@@ -32,6 +32,7 @@ void PocketBuilder::move(MoveKind kind, Vec3 to, double feed, bool cutting, std:
   m.kind = kind;
   m.to = to;
   m.feed = kind == MoveKind::Rapid ? 0 : feed;
+  m.spindle = kind == MoveKind::Rapid ? 0 : spindle_;
   m.process_on = cutting;
   if (!pending_comment_.empty()) {
     m.comment = pending_comment_ + (comment.empty() ? "" : "; " + comment);

@@ -244,6 +244,7 @@ void PocketBuilder::stamp_surface_pass(const std::vector<Vec3>& pts) {
 }
 
 void PocketBuilder::cut_surface_pass(const std::vector<Vec3>& pts, const std::vector<Vec3>& link) {
+  spindle_ = tool_.finishing_spindle_speed();
   const Vec3 s = pts.front();
   std::vector<Vec3> swept;
   if (!link.empty()) {
@@ -261,6 +262,7 @@ void PocketBuilder::cut_surface_pass(const std::vector<Vec3>& pts, const std::ve
   swept.insert(swept.end(), pts.begin(), pts.end());
   stamp_surface_pass(swept);
   ++surface_passes_;
+  spindle_ = 0;
 }
 
 void PocketBuilder::finish_surfaces() {

@@ -201,7 +201,7 @@ TEST(MachineDefaults, ToolDefaultsFollowTheTypeAndDiameter) {
       "envelope: {X: {travel: [0, 100]}, Y: {travel: [0, 100]}, Z: {travel: [0, 200]}}\n"
       "tools:\n"
       "  - {number: 5, type: ball, diameter: 8}\n"
-      "  - {number: 6, type: flat, diameter: 4, name: small, finish_feed: 450}\n"
+      "  - {number: 6, type: flat, diameter: 4, name: small, finish_feed: 450, finish_spindle_speed: 14000}\n"
       "setups: [{name: s}]\n",
       "t.yaml");
   const CuttingTool& ball = *m.find_tool(5);
@@ -215,12 +215,14 @@ TEST(MachineDefaults, ToolDefaultsFollowTheTypeAndDiameter) {
   EXPECT_EQ(ball.feed, 1000.0);
   EXPECT_EQ(ball.plunge_feed, 300.0);
   EXPECT_EQ(ball.finishing_feed(), 1000.0) << "the feed, when no finish_feed is given";
+  EXPECT_EQ(ball.finishing_spindle_speed(), ball.spindle_speed) << "the spindle speed, when none is given";
   EXPECT_EQ(ball.cost_per_mm3, 1.0);
   EXPECT_TRUE(ball.offers(PrimitiveKind::SmMax));
   EXPECT_TRUE(ball.offers(PrimitiveKind::SmCons));
   EXPECT_EQ(m.find_tool(6)->name, "small");
   EXPECT_EQ(m.find_tool(6)->corner_radius, 0.0);
   EXPECT_EQ(m.find_tool(6)->finishing_feed(), 450.0);
+  EXPECT_EQ(m.find_tool(6)->finishing_spindle_speed(), 14000.0);
 }
 
 TEST(MachineSummary, NamesEverySection) {

@@ -168,6 +168,28 @@ TEST(PostRs274ngc, FeedsAreWrittenOnlyWhenTheyChange) {
   EXPECT_EQ(written, changes) << text;
 }
 
+// A pass at its own spindle speed (a finishing pass): S before it and back after, and the
+// controller runs each move at the speed its pass asks for.
+TEST(PostRs274ngc, APassAtItsOwnSpindleSpeedChangesSAndBack) {
+  const Machine m = example("hybrid-3axis.yaml");
+  std::vector<ActionProgram> actions = sample_actions(m);
+  ActionProgram& milling = actions[1];  // with T1
+  const double rough = m.find_tool(milling.path.tool_number)->spindle_speed;
+  std::size_t fast = 0;
+  for (std::size_t k = 0; k < milling.path.moves.size(); ++k)
+    if (milling.path.moves[k].kind != MoveKind::Rapid && k % 2 == 0) milling.path.moves[k].spindle = 12345, ++fast;
+  ASSERT_GT(fast, 0u);
+  const std::string text = write_program(actions, m);
+  EXPECT_GE(count_lines(text, "S12345"), 1) << text;
+  EXPECT_GE(count_lines(text, "S" + std::to_string(std::lround(rough))), 1) << text;
+  const Program program = interpret(text, m, "post.ngc");
+  std::size_t at_fast = 0;
+  for (const Motion& motion : program.motions)
+    if (motion.kind != MotionKind::Rapid && motion.spindle_speed == 12345) ++at_fast;
+  EXPECT_EQ(at_fast, fast);
+  expect_round_trip(actions, m, text);
+}
+
 TEST(PostRs274ngc, RotarySetupChangeOnTheBAxisMachine) {
   Machine m = example("multitask-b-axis.yaml");
   m.gcode.dialect = hybridctl::config::Dialect::Rs274ngc;

@@ -503,6 +503,7 @@ TEST(PocketPath, WallFinishingPutsAFlatCuttersSideOnThePocketsRealWalls) {
   const Solid roi = geometry::subtract(stock, design);
   auto tool = flat_4mm();
   tool.finish_feed = tool.feed / 2;
+  tool.finish_spindle_speed = tool.spindle_speed * 1.5;
   const double r = tool.diameter / 2;
   PocketOptions on;
   on.design = mesh;
@@ -550,6 +551,7 @@ TEST(PocketPath, WallFinishingPutsAFlatCuttersSideOnThePocketsRealWalls) {
     if (p.moves[i].comment == "finish lead-in arc") arc = true;
     if (p.moves[i].comment != "finish lead-in") continue;
     EXPECT_EQ(p.moves[i].feed, tool.finish_feed) << "the finishing passes run at the tool's finishing feed";
+    EXPECT_EQ(p.moves[i].spindle, tool.finish_spindle_speed) << "... and spindle speed";
     if (arc) {
       ++arc_leads;
       const Vec3 a = p.moves[i - 1].to, b = p.moves[i].to, c = p.moves[i + 1].to;
@@ -560,6 +562,10 @@ TEST(PocketPath, WallFinishingPutsAFlatCuttersSideOnThePocketsRealWalls) {
     arc = false;
   }
   EXPECT_GT(arc_leads, 0);
+  // The roughing's feed moves keep the tool's own spindle speed.
+  EXPECT_TRUE(std::any_of(p.moves.begin(), p.moves.end(), [&](const PathMove& m) {
+    return m.kind == MoveKind::Feed && m.feed == tool.feed && m.spindle == 0;
+  }));
   // What stays of the ROI on the voxels is no more than without the finishing.
   const Replay rq = replay(q, stock, design, tool);
   EXPECT_LE(geometry::intersect(rp.present, roi).voxel_count(), geometry::intersect(rq.present, roi).voxel_count());
