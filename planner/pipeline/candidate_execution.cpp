@@ -59,9 +59,7 @@ void validate_by_execution(PlanningOptions& options, plan::CandidateValidator va
     };
     std::map<std::vector<int>, Proven> proven;
     const Proven* proven_of(const Plan& plan) const {
-      std::vector<int> key;
-      for (const PlanStep& s : plan.steps) key.push_back(s.primitive);
-      const auto it = proven.find(key);
+      const auto it = proven.find(plan.primitives());
       return it == proven.end() ? nullptr : &it->second;
     }
   };
@@ -84,9 +82,7 @@ void validate_by_execution(PlanningOptions& options, plan::CandidateValidator va
     const plan::PlanFile& file = file_of(r);
     plan::CandidateRun run = state->validator.execute(file, candidate_plan(r, plan));
     if (run.proven()) {
-      std::vector<int> key;
-      for (const PlanStep& s : plan.steps) key.push_back(s.primitive);
-      state->proven[key] = {run.action_minutes, run.cycle_time, run.exact};
+      state->proven[plan.primitives()] = {run.action_minutes, run.cycle_time, run.exact};
     }
     return learn_from_run(r, plan, *state->file, std::move(run), state->core);
   };

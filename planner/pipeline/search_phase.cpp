@@ -26,11 +26,7 @@ struct Learning {
   std::set<std::vector<int>> proven;
 };
 
-std::vector<int> primitives_of(const Plan& plan) {
-  std::vector<int> sequence;
-  for (const PlanStep& s : plan.steps) sequence.push_back(s.primitive);
-  return sequence;
-}
+std::vector<int> primitives_of(const Plan& plan) { return plan.primitives(); }
 
 // The search's accept hook from PlanningOptions::validate: rejected plans are kept with
 // their reasons (once each, as a weighted search may find them again), their shortfalls

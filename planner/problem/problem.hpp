@@ -99,6 +99,13 @@ struct Plan {
   bool exact = true;  // proven to be the rank-th cheapest accepted plan
   bool built = false;  // built step by step (planner/search/greedy.hpp), not found by a search
   bool replayed = false;  // the proof's replay (SearchOptions::seeds), not found by a search
+
+  // Its primitives in order: what names a plan wherever plans are matched or looked up.
+  std::vector<int> primitives() const {
+    std::vector<int> s;
+    for (const PlanStep& step : steps) s.push_back(step.primitive);
+    return s;
+  }
 };
 
 }  // namespace hybridctl::planner

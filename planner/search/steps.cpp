@@ -21,11 +21,7 @@ bool allowed(const PlanningProblem& p, int i, bool first, const std::vector<std:
   return !prim.raw_stock;                         // C4
 }
 
-std::vector<int> sequence_of(const Plan& plan) {
-  std::vector<int> s;
-  for (const PlanStep& step : plan.steps) s.push_back(step.primitive);
-  return s;
-}
+std::vector<int> sequence_of(const Plan& plan) { return plan.primitives(); }
 
 std::vector<std::uint64_t> effect_of(const PlanningProblem& p, const std::vector<int>& sequence) {
   std::vector<std::uint64_t> key;
