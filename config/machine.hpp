@@ -97,6 +97,20 @@ constexpr double default_accuracy(DepositionProcess p) {
   return 0.25;
 }
 
+/// The stock an overfill deposit (O-AM) leaves beyond the design for a removal to finish,
+/// mm, when the machine file gives none: shops deposit near-net plus 0.5-2 mm and mill it
+/// off (docs/machine-file.md cites the sources): powder DED and laser wire 0.5, DED wire
+/// 1.0, wire-arc 2.0.
+constexpr double default_machining_allowance(DepositionProcess p) {
+  switch (p) {
+    case DepositionProcess::DedPowder: return 0.5;
+    case DepositionProcess::LaserWire: return 0.5;
+    case DepositionProcess::DedWire: return 1.0;
+    case DepositionProcess::WireArc: return 2.0;
+  }
+  return 0.5;
+}
+
 /// What a head's deposit is made of, for what it costs (docs/costs.md).
 struct DepositMaterial {
   double density = 7.9;                 ///< g/cm³ (316L stainless steel); > 0
@@ -157,6 +171,9 @@ struct AdditiveHead {
   /// mm, > 0: a face left as deposited lies within this of the modelled bead's surface,
   /// either way (its as-deposited accuracy); default by process (default_accuracy).
   double accuracy = default_accuracy(DepositionProcess::DedPowder);
+  /// mm, >= 0: an overfill deposit (O-AM) covers the design by at least this everywhere,
+  /// the stock a finishing removal takes off; default by process (default_machining_allowance).
+  double machining_allowance = default_machining_allowance(DepositionProcess::DedPowder);
   double feed = 1000.0;                 ///< mm/min while depositing
   /// The T number that selects the head (`T.. M6`); default 100 + its index in `heads`;
   /// unique among heads and never a cutting tool's number.

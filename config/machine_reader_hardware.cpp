@@ -81,7 +81,8 @@ std::optional<std::size_t> MachineReader::read_heads(const Value& v) {
 void MachineReader::read_head(const Value& v) {
   MapReader r(sink_, v,
               {"name", "process", "bead", "nozzle", "support", "layer_height", "hatch_spacing", "travel_clearance",
-               "accuracy", "feed", "tool_number", "codes", "cost_per_mm3", "deposition_rate", "material", "primitives"});
+               "accuracy", "machining_allowance", "feed", "tool_number", "codes", "cost_per_mm3", "deposition_rate",
+               "material", "primitives"});
   if (!r.ok()) return;
   AdditiveHead h;
   if (auto f = r.require("name")) {
@@ -129,6 +130,8 @@ void MachineReader::read_head(const Value& v) {
   number(r, "travel_clearance", kLength, Bound::NonNegative, h.travel_clearance);
   h.accuracy = default_accuracy(h.process);
   number(r, "accuracy", kLength, Bound::Positive, h.accuracy);
+  h.machining_allowance = default_machining_allowance(h.process);
+  number(r, "machining_allowance", kLength, Bound::NonNegative, h.machining_allowance);
   number(r, "feed", kFeed, Bound::Positive, h.feed);
   // The T number: given, or 100 + the head's index; clashes are checked once tools are read.
   h.tool_number = kDefaultHeadToolNumberBase + static_cast<int>(machine_.heads.size());

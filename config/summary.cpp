@@ -59,6 +59,7 @@ std::string summarize(const Machine& m) {
                        fmt(h.feed) + " mm/min, " + fmt(h.volume_rate()) + " mm³/min, " + primitives(h.primitives);
     text += ", overhang <= " + fmt(h.support.max_overhang) + " deg, " +
             (h.support.max_bridge > 0 ? "bridges <= " + fmt(h.support.max_bridge) + " mm" : std::string("no bridging"));
+    text += ", as deposited within " + fmt(h.accuracy) + " mm, machining allowance " + fmt(h.machining_allowance) + " mm";
     if (h.nozzle)
       text += ", nozzle ø" + fmt(h.nozzle->diameter) + " x " + fmt(h.nozzle->length) + " mm at " +
               fmt(h.nozzle->standoff) + " mm standoff";

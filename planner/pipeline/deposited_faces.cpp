@@ -64,13 +64,18 @@ FaceRule make_face_rule(const config::Machine& machine, const std::vector<Primit
     const PrimitiveSpec& spec = problem.primitives[i];
     if (spec.mode != Mode::Additive || spec.raw_stock) continue;
     const config::AdditiveHead* head = machine.find_head(primitives[i].capability);
-    if (!head || head->accuracy <= tolerance) continue;
+    if (!head) continue;
+    const bool coarse = head->accuracy > tolerance;
+    const bool allowance = primitives[i].kind == PrimitiveKind::OAm && head->machining_allowance > tolerance;
+    if (!coarse && !allowance) continue;
     AtomSet tight(n);
     for (int a = 0; a < n; ++a)
       if (rule.surface[std::size_t(a)] && spec.atoms.test(a)) tight.set(a);
     rule.tight[i] = std::move(tight);
-    rule.why[i] = "its head " + head->name + " lays material within " + trimmed_number(head->accuracy, 3) +
-                  " mm of its beads, coarser than the tolerance " + trimmed_number(tolerance, 3) + " mm";
+    rule.why[i] = coarse ? "its head " + head->name + " lays material within " + trimmed_number(head->accuracy, 3) +
+                               " mm of its beads, coarser than the tolerance " + trimmed_number(tolerance, 3) + " mm"
+                         : "it is laid with the machining allowance of " + head->name + ", " +
+                               trimmed_number(head->machining_allowance, 3) + " mm beyond the design, for a removal to finish";
   }
   return rule;
 }

@@ -4,19 +4,21 @@
 // allows it, and elsewhere a removal after the deposit finishes it. The search passes over
 // plans that break it before anything is executed.
 //
-// Two sources say where a deposit's faces are too rough:
+// Three things say where a deposit's faces may not stay as laid:
 // - its head's as-deposited accuracy (config::AdditiveHead::accuracy) is coarser than the
 //   part's tolerance: none of its faces may stay as laid;
+// - it is an overfill deposit (O-AM), laid with the head's machining allowance
+//   (config::AdditiveHead::machining_allowance) beyond the design, and the allowance is more
+//   than the tolerance: none of its faces may stay as laid;
 // - an executed candidate left a face of it beyond the tolerance as deposited (exact
 //   verification names the place and the action): that face, wherever the plan stands,
 //   since the bead's shape there does not depend on what came before (a judgement, like
 //   validation's own skip rules, that spares executing the same face again in every order).
 //
 // A face counts as finished when a removal after the deposit clears air next to it:
-// material stood there (the deposit's overfill, an O-AM primitive's, which is the
-// machining allowance of the symbolic model; stock; an earlier deposit), and the removal's
-// region of influence meets the face, so its finishing passes cut it to the design's real
-// surface; exact verification judges the result. A deposit laid near-net (U-AM) and a
+// material stood there (an O-AM primitive's machining allowance, stock, an earlier
+// deposit), and the removal's region of influence meets the face, so its finishing passes
+// cut it to the design's real surface; exact verification judges the result. A deposit laid near-net (U-AM) and a
 // removal that only runs in air beside it leave the face as laid. The rule is lenient on
 // purpose: it only spares executions whose outcome is already known.
 

@@ -85,6 +85,55 @@ std::string joined(const std::vector<std::string>& names, const char* last = " a
   return out;
 }
 
+// Air joined face by face to `seeds` through the voxels `within` accepts: the feature the
+// shop sees (a whole cavity, a whole slot), however the atoms split it. `id` (its first
+// voxel in the domain's order) tells one from another. None when it reaches the domain's
+// edge and `closed` asks for a closed space (the way out bends round the part), or when it
+// is larger than `cap` voxels.
+struct AirBody {
+  std::int64_t id = -1;
+  std::int64_t voxels = 0;
+  geometry::Vec3 at;  // mm: its middle
+};
+
+template <class Within>
+std::optional<AirBody> air_body(const PlanningResult& r, const std::vector<Index3>& seeds, bool closed, Within within) {
+  constexpr std::int64_t kCap = 4'000'000;
+  const geometry::IndexBox& d = r.domain;
+  const std::int64_t nx = d.hi.x - d.lo.x, ny = d.hi.y - d.lo.y;
+  const auto index = [&](Index3 p) { return (std::int64_t(p.z - d.lo.z) * ny + (p.y - d.lo.y)) * nx + (p.x - d.lo.x); };
+  std::vector<bool> seen(std::size_t(d.voxel_count()), false);
+  std::vector<Index3> queue;
+  for (const Index3& p : seeds)
+    if (d.contains(p) && !r.design.contains(p) && within(p) && !seen[std::size_t(index(p))])
+      seen[std::size_t(index(p))] = true, queue.push_back(p);
+  AirBody body;
+  double x = 0, y = 0, z = 0;
+  for (std::size_t k = 0; k < queue.size(); ++k) {
+    if (std::int64_t(queue.size()) > kCap) return std::nullopt;
+    const Index3 p = queue[k];
+    const std::int64_t i = index(p);
+    body.id = body.id < 0 ? i : std::min(body.id, i);
+    const geometry::Vec3 m = r.lattice.center(p);
+    x += m.x, y += m.y, z += m.z;
+    for (const Direction& dir : kDirections) {
+      const Index3 q{p.x + dir.step.x, p.y + dir.step.y, p.z + dir.step.z};
+      if (!d.contains(q)) {
+        if (closed) return std::nullopt;
+        continue;
+      }
+      if (r.design.contains(q) || seen[std::size_t(index(q))] || !within(q)) continue;
+      seen[std::size_t(index(q))] = true;
+      queue.push_back(q);
+    }
+  }
+  body.voxels = std::int64_t(queue.size());
+  if (body.voxels == 0) return std::nullopt;
+  const double n = double(body.voxels);
+  body.at = {x / n, y / n, z / n};
+  return body;
+}
+
 // Closed spaces: `count` regions of `air` mm^3 in all, the first around `at`.
 std::string closed_space_words(double air, int count, const geometry::Vec3& at) {
   const std::string volume = trimmed_number(air, air < 10 ? 2 : 0) + " mm\u00B3";
@@ -103,6 +152,7 @@ struct AirWords {
   geometry::Vec3 at;    // mm: the middle of its air
   std::string line;     // empty: nothing certain to say
   std::string gap;      // a narrow slot: its width and the side it opens to, which its other regions share
+  std::int64_t body = -1;  // the cavity or slot it is part of (AirBody::id), said once for all its regions
 };
 
 AirWords air_in_words(const config::Machine& machine, const PlanningResult& r, const ViolatingAtom& v) {
@@ -131,6 +181,12 @@ AirWords air_in_words(const config::Machine& machine, const PlanningResult& r, c
   said.at = at;
   if (open.empty()) {
     said.closed = true;
+    // The whole cavity, as far as it is closed in: the shop's feature, not the atom's share.
+    if (const std::optional<AirBody> c = air_body(r, voxels, true, [](Index3) { return true; })) {
+      said.body = c->id;
+      said.air = double(c->voxels) * h * h * h;
+      said.at = c->at;
+    }
     return said;
   }
   const auto has_setup = [&](const Direction& d) {
@@ -182,8 +238,23 @@ AirWords air_in_words(const config::Machine& machine, const PlanningResult& r, c
     }
   }
   if (smallest->diameter > widest + 1e-9) {
+    // The whole slot: the air joined to this region where the gap is as narrow.
+    const auto side = std::find_if(kDirections.begin(), kDirections.end(),
+                                   [&](const Direction& d) { return d.name == widest_side; });
+    const auto narrow = [&](Index3 p) {
+      const double w = gap_width(r.design, p, side->step, reach, h);
+      return w >= 0 && w < smallest->diameter - 1e-9;
+    };
+    std::string slot_volume = volume;
+    if (side == kDirections.end()) {
+    } else if (const std::optional<AirBody> slot = air_body(r, voxels, false, narrow)) {
+      said.body = slot->id;
+      said.air = double(slot->voxels) * h * h * h;
+      at = said.at = slot->at;
+      slot_volume = trimmed_number(said.air, said.air < 10 ? 2 : 0) + " mm\u00B3";
+    }
     said.gap = trimmed_number(widest, 2) + " " + widest_side;
-    said.line = "narrow slot: a " + volume + " gap around " + around(at) + " is " + trimmed_number(widest, 2) +
+    said.line = "narrow slot: a " + slot_volume + " gap around " + around(at) + " is " + trimmed_number(widest, 2) +
            " mm wide at most where it opens to " + widest_side + "; the smallest cutter, " + smallest->name + " (" +
            trimmed_number(smallest->diameter, 2) + " mm), does not fit; a cutter of " + trimmed_number(widest, 2) +
            " mm or less across would do";
@@ -457,6 +528,7 @@ std::vector<std::string> refusal_in_shop_words(const config::Machine& machine, c
   double closed_air = 0;
   geometry::Vec3 closed_at;
   std::vector<std::string> gaps;
+  std::vector<std::int64_t> bodies;  // the cavities and slots said already
   std::vector<std::pair<std::size_t, Overhang>> overhangs;  // the line each is said on
   Builds builds{build_ways(machine), {}};
   for (const ViolatingAtom& v : r.verdict.violations) {
@@ -466,12 +538,19 @@ std::vector<std::string> refusal_in_shop_words(const config::Machine& machine, c
     if (r.problem.atoms[a].must_out) {
       const AirWords said = air_in_words(machine, r, v);
       if (said.closed) {
-        if (closed++ == 0) closed_line = out.size(), closed_at = said.at, out.emplace_back();
-        closed_air += said.air;
+        // A cavity split among regions is said once, at its whole volume.
+        const bool again = said.body >= 0 && std::find(bodies.begin(), bodies.end(), said.body) != bodies.end();
+        if (said.body >= 0) bodies.push_back(said.body);
+        if (!again) {
+          if (closed++ == 0) closed_line = out.size(), closed_at = said.at, out.emplace_back();
+          closed_air += said.air;
+        }
       } else if (!said.line.empty() && out.size() < limit &&
                  // The same slot's other regions (its floor, its ends) say the same thing again.
-                 (said.gap.empty() || std::find(gaps.begin(), gaps.end(), said.gap) == gaps.end())) {
+                 (said.gap.empty() || std::find(gaps.begin(), gaps.end(), said.gap) == gaps.end()) &&
+                 (said.body < 0 || std::find(bodies.begin(), bodies.end(), said.body) == bodies.end())) {
         if (!said.gap.empty()) gaps.push_back(said.gap);
+        if (said.body >= 0) bodies.push_back(said.body);
         out.push_back(said.line);
       }
     }

@@ -97,7 +97,11 @@ std::vector<Primitive> deposit_primitives(const config::Machine& m, const Solid&
       }
   tbb::parallel_for(std::size_t(0), deposits.size(), [&](std::size_t k) {
     Deposit& d = deposits[k];
-    const Instrument in = bead_instrument(*d.head, d.setup->approach);
+    Instrument in = bead_instrument(*d.head, d.setup->approach);
+    // The overfill covers the design by a bead and by the machining allowance, the stock a
+    // finishing removal takes off (the face rule holds it to being finished).
+    if (d.p.kind == PrimitiveKind::OAm && d.head->machining_allowance > 0)
+      in.cutting.push_back(geometry::Ball{d.head->machining_allowance});
     const Solid region = d.p.kind == PrimitiveKind::UAm ? additive_maximal(design, in) : additive_conservative(design, in);
     // Only what the head builds without support in this setup.
     d.p.region = self_supporting(region, instruments::approach_direction(d.setup->approach),

@@ -216,7 +216,7 @@ TEST_F(Cli, ARefusalIsSaidInShopWordsWithItsProofInAtomsBehindVerbose) {
                        "verdict, or --verbose)\n"),
             std::string::npos)
       << r.out;
-  EXPECT_NE(r.out.find("\nin words    closed space: a 205 mm³ cavity around "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\nin words    closed space: a 2560 mm³ cavity around (25.0, 15.0, 16.0) mm "), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("(must be made), in "), std::string::npos) << r.out;
   EXPECT_EQ(r.out.find("atoms right together"), std::string::npos) << r.out;
   EXPECT_NE(slurp(dir_ / "plan" / "plan.json").find("\"violations\": [\n"), std::string::npos);

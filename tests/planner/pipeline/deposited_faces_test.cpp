@@ -1,12 +1,12 @@
 // The rule of faces left as deposited (planner/pipeline/deposited_faces.hpp): a deposit
-// whose head lays material coarser than the tolerance may leave none of its faces as it
-// laid them, and one an executed candidate showed beyond the tolerance at a place may not
-// leave that face again; a removal after it that clears material beside the face (an
-// overfill) finishes it.
+// whose head lays material coarser than the tolerance, or an overfill laid with a
+// machining allowance beyond it, may leave none of its faces as it laid them, and one an
+// executed candidate showed beyond the tolerance at a place may not leave that face
+// again; a removal after it that clears material beside the face (an overfill) finishes it.
 //
 // The problem: a block 4 x 4 x 3 mm on a 1 mm grid, deposited near-net (P1) or with a
-// millimetre of overfill round it (P2), a removal that holds all the air round it (P3),
-// and one that holds only air far off (P4).
+// millimetre of overfill round it (P2, an O-AM), a removal that holds all the air round it
+// (P3), and one that holds only air far off (P4).
 
 #include <gtest/gtest.h>
 
@@ -45,6 +45,7 @@ struct Block {
       p.name = "P" + std::to_string(i + 1);
       p.mode = kinds[i].first;
       p.capability = kinds[i].second;
+      if (i == 1) p.kind = PrimitiveKind::OAm;
       primitives.push_back(p);
       PrimitiveSpec s;
       s.name = p.name;
@@ -59,11 +60,12 @@ struct Block {
       problem.atoms.push_back({m.volume, m.atom_class == AtomClass::MustIn, m.atom_class == AtomClass::MustOut});
   }
 
-  FaceRule rule(double head_accuracy, double tolerance) const {
+  FaceRule rule(double head_accuracy, double tolerance, double allowance = 0.5) const {
     config::Machine machine;
     config::AdditiveHead head;
     head.name = "powder";
     head.accuracy = head_accuracy;
+    head.machining_allowance = allowance;
     machine.heads.push_back(head);
     return make_face_rule(machine, primitives, problem, atoms, measures, tolerance);
   }
@@ -99,6 +101,22 @@ TEST(DepositedFaces, AHeadWithinTheToleranceMayLeaveItsFacesAsLaid) {
   const FaceRule rule = b.rule(0.25, 0.5);
   EXPECT_FALSE(face_left_as_deposited(b.problem, rule, plan_of({0})).has_value());
   EXPECT_TRUE(rule.why[0].empty());
+}
+
+TEST(DepositedFaces, ADepositLaidWithAnAllowanceBeyondTheToleranceLeavesNoFaceAsLaid) {
+  const Block b;
+  const FaceRule rule = b.rule(0.25, 0.5, 1.0);
+  EXPECT_TRUE(rule.why[0].empty());  // near-net: its faces may stay
+  EXPECT_FALSE(face_left_as_deposited(b.problem, rule, plan_of({0})).has_value());
+  const std::optional<FaceLeft> left = face_left_as_deposited(b.problem, rule, plan_of({1}));
+  ASSERT_TRUE(left.has_value());
+  EXPECT_NE(describe_face_left(b.problem, rule, b.measures, plan_of({1}), *left)
+                .find("it is laid with the machining allowance of powder, 1 mm beyond the design, for a removal to finish"),
+            std::string::npos);
+  EXPECT_FALSE(face_left_as_deposited(b.problem, rule, plan_of({1, 2})).has_value());
+  EXPECT_TRUE(face_left_as_deposited(b.problem, rule, plan_of({1, 3})).has_value());
+  // An allowance within the tolerance may stay as laid.
+  EXPECT_FALSE(face_left_as_deposited(b.problem, b.rule(0.25, 0.5, 0.4), plan_of({1})).has_value());
 }
 
 TEST(DepositedFaces, AFaceAnExecutedCandidateLeftOutIsNotLeftAgain) {

@@ -87,6 +87,29 @@ TEST(MachinePrimitives, EveryRemovalRegionEqualsItsDefinitionFromEverySide) {
   EXPECT_EQ(primitives.size(), machine_primitive_count(machine));
 }
 
+// An overfill deposit (O-AM) covers the design by the head's machining allowance
+// everywhere it builds: a block on the plate, deposited from the top with an allowance of
+// 1 mm, has every voxel within 1 mm of it above the plate; without the allowance it has
+// only what a bead leaves (half its width sideways, half its height up).
+TEST(MachinePrimitives, AnOverfillDepositCoversTheDesignByTheMachiningAllowance) {
+  config::Machine machine = config::parse_machine(kMachine, "six-sided.yaml");
+  machine.setups.resize(1);
+  machine.tools.clear();
+  const Lattice lattice{machine.planning.voxel_size, {0, 0, 0}};
+  const Solid design = make_box(lattice, {{0, 0, 0}, {6, 6, 4}});
+  const IndexBox domain = planning_domain(machine, lattice, design.bounding_box_mm(), machine.planning.tolerance);
+  const auto overfill = [&](double allowance) {
+    machine.heads[0].machining_allowance = allowance;
+    for (const Primitive& p : machine_primitives(machine, design, domain))
+      if (p.kind == PrimitiveKind::OAm) return p.region;
+    ADD_FAILURE() << "no O-AM";
+    return Solid(lattice, domain);
+  };
+  const Solid grown = intersect(dilate(design, Ball{1.0}, domain), make_box(lattice, {{-5, -5, 0}, {11, 11, 9}}));
+  EXPECT_EQ(subtract(grown, overfill(1.0)).voxel_count(), 0);
+  EXPECT_GT(subtract(grown, overfill(0.0)).voxel_count(), 0);
+}
+
 // The memory check counts every primitive the machine offers over all its setups, and the
 // banded ones it may add (two levels, each on one setup here: its deposit and its cutter),
 // the filled deposits (one per head with an O-AM and setup), and the fine-grained ones (at
