@@ -25,7 +25,8 @@ CandidateCheck learn_from_run(const PlanningResult& r, const Plan& plan, const p
     for (const plan::ExactPlace* place : {&run.exact->excess, &run.exact->gouge})
       if (place->as_deposited && place->at && place->mm > run.exact->tolerance && place->action >= 1 &&
           std::size_t(place->action) <= plan.steps.size())
-        faces.push_back({plan.steps[std::size_t(place->action - 1)].primitive, *place->at, place->mm});
+        faces.push_back({plan.steps[std::size_t(place->action - 1)].primitive, *place->at, place->mm,
+                         place == &run.exact->excess});
   if (!run.as_built) {
     CandidateCheck check{std::move(run.reasons)};
     check.faces = std::move(faces);

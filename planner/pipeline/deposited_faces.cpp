@@ -109,9 +109,9 @@ bool learn_face(FaceRule& rule, const PlanningProblem& problem, const AtomDecomp
   std::vector<LearnedFaceAtom>& known = rule.learned_atoms[std::size_t(face.primitive)];
   bool added = false;
   for (const int a : on_surface) {
-    const auto same = [&](const LearnedFaceAtom& k) { return k.atom == a && k.air_near == air; };
+    const auto same = [&](const LearnedFaceAtom& k) { return k.atom == a && k.air_near == air && k.excess == face.excess; };
     if (std::any_of(known.begin(), known.end(), same)) continue;
-    known.push_back({a, air});
+    known.push_back({a, air, face.excess});
     added = true;
   }
   if (added) {
@@ -141,6 +141,21 @@ bool cleared_after(const PlanningProblem& problem, const Plan& plan, const std::
   return false;
 }
 
+// A removal among the plan's steps after `step` whose region holds an atom of `air`: it
+// meets whatever stands there in the material really present, a bead's overfill included.
+bool held_after(const PlanningProblem& problem, const Plan& plan, std::size_t step, const AtomSet& air) {
+  const auto& a = air.words();
+  for (std::size_t later = step + 1; later < plan.steps.size(); ++later) {
+    const PrimitiveSpec& removal = problem.primitives[std::size_t(plan.steps[later].primitive)];
+    if (removal.mode != Mode::Subtractive) continue;
+    const auto& region = removal.atoms.words();
+    const auto& short_of = removal.falls_short.words();  // what execution showed it does not reach
+    for (std::size_t w = 0; w < a.size() && w < region.size(); ++w)
+      if (a[w] & region[w] & ~(w < short_of.size() ? short_of[w] : 0)) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 std::optional<FaceLeft> face_left_as_deposited(const PlanningProblem& problem, const FaceRule& rule, const Plan& plan) {
@@ -162,7 +177,9 @@ std::optional<FaceLeft> face_left_as_deposited(const PlanningProblem& problem, c
         if (tight.test(a) && laid_last(a, s) && !cleared_after(problem, plan, changed, s, rule.air_beside[std::size_t(a)]))
           return FaceLeft{s, a};
     for (const LearnedFaceAtom& f : rule.learned_atoms[std::size_t(p)])
-      if (laid_last(f.atom, s) && !cleared_after(problem, plan, changed, s, f.air_near)) return FaceLeft{s, f.atom};
+      if (laid_last(f.atom, s) && !(f.excess ? held_after(problem, plan, s, f.air_near)
+                                             : cleared_after(problem, plan, changed, s, f.air_near)))
+        return FaceLeft{s, f.atom};
   }
   return std::nullopt;
 }

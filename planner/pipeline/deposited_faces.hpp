@@ -15,7 +15,8 @@
 //   since the bead's shape there does not depend on what came before (a judgement, like
 //   validation's own skip rules, that spares executing the same face again in every order).
 //
-// A face counts as finished when a removal after the deposit clears air next to it:
+// A face counts as finished when a removal after the deposit clears air next to it (or,
+// for a learned face that stands out, holds air next to it: LearnedFaceAtom):
 // material stood there (an O-AM primitive's machining allowance, stock, an earlier
 // deposit), and the removal's region of influence meets the face, so its finishing passes
 // cut it to the design's real surface; exact verification judges the result. A deposit laid near-net (U-AM) and a
@@ -40,13 +41,19 @@ struct DepositedFace {
   int primitive = -1;  // the deposit that laid it
   geometry::Vec3 at;   // mm, part frame: the place exact verification named
   double mm = 0;       // how far off, the head's accuracy included
+  bool excess = true;  // it stands out of the design there (else it falls short of it)
 };
 
 // An atom whose face a deposit left beyond the tolerance at one place, with the atoms free
-// of the design around that place: a removal holding one of those reaches the face there.
+// of the design around that place. Where the deposit stands out there, a removal after it
+// whose region holds one of those atoms finishes the face: it is planned against the
+// material really present (docs/export.md), the bead's overfill included, and its
+// finishing passes cut that to the design's real surface. Where the deposit falls short,
+// only one that clears material laid beyond the face there (an overfill deposit's) does.
 struct LearnedFaceAtom {
   int atom = -1;
   AtomSet air_near;
+  bool excess = true;
 };
 
 struct FaceRule {

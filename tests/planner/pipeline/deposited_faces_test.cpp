@@ -2,7 +2,8 @@
 // whose head lays material coarser than the tolerance, or an overfill laid with a
 // machining allowance beyond it, may leave none of its faces as it laid them, and one an
 // executed candidate showed beyond the tolerance at a place may not leave that face
-// again; a removal after it that clears material beside the face (an overfill) finishes it.
+// again; a removal after it that clears material beside the face (an overfill) finishes it,
+// and where the face stood out, one whose region holds the air beside it.
 //
 // The problem: a block 4 x 4 x 3 mm on a 1 mm grid, deposited near-net (P1) or with a
 // millimetre of overfill round it (P2, an O-AM), a removal that holds all the air round it
@@ -134,10 +135,27 @@ TEST(DepositedFaces, AFaceAnExecutedCandidateLeftOutIsNotLeftAgain) {
             std::string::npos);
   EXPECT_FALSE(face_left_as_deposited(b.problem, rule, plan_of({1, 2})).has_value());
   EXPECT_FALSE(face_left_as_deposited(b.problem, rule, plan_of({1})).has_value());  // another deposit's face
-  EXPECT_TRUE(face_left_as_deposited(b.problem, rule, plan_of({0, 2})).has_value());
+  // It stood out: a removal after the near-net deposit whose region holds the air there
+  // meets the bead's overfill in the material really present and finishes it; one that
+  // holds only air far off does not.
+  EXPECT_FALSE(face_left_as_deposited(b.problem, rule, plan_of({0, 2})).has_value());
+  EXPECT_TRUE(face_left_as_deposited(b.problem, rule, plan_of({0, 3})).has_value());
   // A removal is never held to it, and a place off every face teaches nothing.
   EXPECT_FALSE(learn_face(rule, b.problem, b.atoms, b.measures, {2, {3.0, 3.0, 3.1}, 0.6}));
   EXPECT_FALSE(learn_face(rule, b.problem, b.atoms, b.measures, {0, {12.5, 4.0, 6.0}, 0.6}));
+}
+
+// A face that fell short of the design as deposited is not finished by cutting air beside
+// it: only a removal that clears material laid beyond it (the overfill's) makes it.
+TEST(DepositedFaces, AFaceAnExecutedCandidateLeftShortIsFinishedOnlyFromAnOverfill) {
+  const Block b;
+  FaceRule rule = b.rule(0.25, 0.5);
+  DepositedFace side{0, {5.1, 3.0, 1.5}, 0.7};
+  side.excess = false;
+  EXPECT_TRUE(learn_face(rule, b.problem, b.atoms, b.measures, side));
+  EXPECT_TRUE(face_left_as_deposited(b.problem, rule, plan_of({0})).has_value());
+  EXPECT_TRUE(face_left_as_deposited(b.problem, rule, plan_of({0, 2})).has_value());
+  EXPECT_FALSE(face_left_as_deposited(b.problem, rule, plan_of({1, 2})).has_value());
 }
 
 }  // namespace
