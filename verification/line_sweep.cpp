@@ -1,6 +1,7 @@
 #include "verification/line_sweep.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -187,6 +188,110 @@ bool surely_misses(const sim::ConvexPiece& piece, const V3& p, const V3& d, doub
   return distance_xy(m, a, b) > piece.reach() + half;
 }
 
+// A cylinder moved along a ramp, in closed form. With t the line's parameter and s the
+// segment's (the piece at a + s m), the pairs (t, s) that put the line's point in the
+// piece are a convex region of the plane: half-planes (s in [0, 1], t in [t0, t1], the
+// height within the piece's slab) and the disc in XY, a quadratic Q(t, s) <= 0. Its
+// least and greatest t lie where two half-planes' lines cross, where a line meets Q = 0,
+// or where Q = 0 runs square to t (dQ/ds = 0); every such point that lies in the region
+// is a candidate. When the line and the ramp run parallel in XY (or either stands still
+// there) Q is a strip between two lines, which joins the half-planes.
+Span cylinder_on_ramp(const sim::ConvexPiece& piece, const V3& p, const V3& d, const V3& a, const V3& m, double t0,
+                      double t1) {
+  struct Line {
+    double at, as, c;  // at t + as s <= c
+  };
+  std::array<Line, 8> lines;
+  std::size_t n = 0;
+  const auto add = [&](double at, double as, double c) {
+    if (std::isfinite(c)) lines[n++] = {at, as, c};
+  };
+  add(0, -1, 0), add(0, 1, 1), add(-1, 0, -t0), add(1, 0, t1);
+  // The height: from <= p.z - a.z + t d.z - s m.z <= to.
+  const double wz = p.z() - a.z();
+  add(-d.z(), m.z(), wz - piece.from);
+  add(d.z(), -m.z(), piece.to - wz);
+  // XY: |w + t u - s v| <= r.
+  const double wx = p.x() - a.x(), wy = p.y() - a.y(), ux = d.x(), uy = d.y(), vx = m.x(), vy = m.y();
+  const double uu = ux * ux + uy * uy, vv = vx * vx + vy * vy, uv = ux * vx + uy * vy, ww = wx * wx + wy * wy;
+  const double cross = ux * vy - uy * vx, r2 = piece.radius * piece.radius;
+  // Q(t, s) = qtt t^2 + 2 qts t s + qss s^2 + 2 qt t + 2 qs s + q0.
+  const double qtt = uu, qts = -uv, qss = vv, qt = wx * ux + wy * uy, qs = -(wx * vx + wy * vy), q0 = ww - r2;
+  const bool strip = cross * cross <= 1e-12 * std::max(1e-300, uu * vv) || uu <= kTiny || vv <= kTiny;
+  if (strip) {
+    if (uu <= kTiny && vv <= kTiny) {
+      if (q0 > 0) return none();
+    } else {
+      const double len = std::sqrt(vv > kTiny ? vv : uu);
+      const double ex = (vv > kTiny ? vx : ux) / len, ey = (vv > kTiny ? vy : uy) / len;
+      const double along = wx * ex + wy * ey, across2 = ww - along * along;
+      if (across2 > r2) return none();
+      const double half = std::sqrt(r2 - across2), ua = ux * ex + uy * ey, va = vx * ex + vy * ey;
+      add(ua, -va, half - along);
+      add(-ua, va, half + along);
+    }
+  }
+  const auto q_of = [&](double t, double u) {
+    return qtt * t * t + 2 * qts * t * u + qss * u * u + 2 * qt * t + 2 * qs * u + q0;
+  };
+  const double eps = 1e-9;
+  const auto feasible = [&](double t, double u) {
+    for (std::size_t k = 0; k < n; ++k)
+      if (lines[k].at * t + lines[k].as * u > lines[k].c + eps * (1 + std::abs(lines[k].c))) return false;
+    return strip || q_of(t, u) <= eps * (1 + r2);
+  };
+  Span out;
+  const auto consider = [&](double t, double u) {
+    if (!std::isfinite(t) || !std::isfinite(u) || !feasible(t, u)) return;
+    out = out.empty() ? Span{t, t} : Span{std::min(out.lo, t), std::max(out.hi, t)};
+  };
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j) {
+      const Line& l = lines[i];
+      const Line& k = lines[j];
+      const double det = l.at * k.as - l.as * k.at;
+      if (std::abs(det) <= kTiny) continue;
+      consider((l.c * k.as - l.as * k.c) / det, (l.at * k.c - l.c * k.at) / det);
+    }
+  if (!strip) {
+    // Q along a line u = alpha + beta t (or t = alpha + beta u): a quadratic's roots.
+    const auto roots = [](double A, double B, double C, double out2[2]) {
+      if (std::abs(A) <= kTiny) {
+        if (std::abs(B) <= kTiny) return 0;
+        out2[0] = -C / B;
+        return 1;
+      }
+      const double disc = B * B - 4 * A * C;
+      if (disc < 0) return 0;
+      const double root = std::sqrt(disc), q = -0.5 * (B + (B >= 0 ? root : -root));
+      out2[0] = q / A;
+      out2[1] = std::abs(q) > kTiny ? C / q : out2[0];
+      return 2;
+    };
+    const auto on_u_of_t = [&](double alpha, double beta) {  // u = alpha + beta t
+      double r[2];
+      const int k = roots(qtt + 2 * qts * beta + qss * beta * beta,
+                          2 * (qts * alpha + qss * alpha * beta + qt + qs * beta),
+                          qss * alpha * alpha + 2 * qs * alpha + q0, r);
+      for (int i = 0; i < k; ++i) consider(r[i], alpha + beta * r[i]);
+    };
+    const auto on_t_of_u = [&](double alpha, double beta) {  // t = alpha + beta u
+      double r[2];
+      const int k = roots(qss + 2 * qts * beta + qtt * beta * beta,
+                          2 * (qts * alpha + qtt * alpha * beta + qs + qt * beta),
+                          qtt * alpha * alpha + 2 * qt * alpha + q0, r);
+      for (int i = 0; i < k; ++i) consider(alpha + beta * r[i], r[i]);
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+      const Line& l = lines[i];
+      if (std::abs(l.as) >= std::abs(l.at)) on_u_of_t(l.c / l.as, -l.at / l.as);
+      else on_t_of_u(l.c / l.at, -l.as / l.at);
+    }
+    on_u_of_t(-qs / qss, -qts / qss);  // where Q = 0 runs square to t
+  }
+  return out;
+}
+
 bool whole_in_slab(const sim::ConvexPiece& piece, double half_height) {
   return piece.from <= piece.centre - half_height + 1e-12 && piece.to >= piece.centre + half_height - 1e-12;
 }
@@ -262,22 +367,7 @@ Span line_in_sweep(const sim::ConvexPiece& piece, const sim::Segment& segment, c
       }
       break;
   }
-  if (piece.kind == Kind::Cylinder) {
-    // On a ramp: the positions whose slab holds the point's height are an interval of the
-    // segment, in closed form, and the nearest of them in XY too.
-    const double zmin = std::min(a.z(), b.z()), zmax = std::max(a.z(), b.z());
-    return sublevel(
-        [&](double t) {
-          const V3 q = p + t * d;
-          // Heights of the programmed point for which the slab holds q: [q.z - to, q.z - from].
-          const double h0 = std::clamp(q.z() - piece.to, zmin, zmax), h1 = std::clamp(q.z() - piece.from, zmin, zmax);
-          const double out_of_slab = std::max({0.0, zmin + piece.from - q.z(), q.z() - (zmax + piece.to)});
-          // Those positions in XY: the sub-segment between the heights h0 and h1.
-          const V3 e0 = a + move * ((h0 - a.z()) / move.z()), e1 = a + move * ((h1 - a.z()) / move.z());
-          return std::max(out_of_slab, distance_xy(q, e0, e1) - piece.radius);
-        },
-        t0, t1);
-  }
+  if (piece.kind == Kind::Cylinder) return cylinder_on_ramp(piece, p, d, a, move, t0, t1);
   if (piece.kind == Kind::Torus) {
     // On a ramp: first the cylinder of its reach over its height, which holds it (closed
     // form above), so that a line that misses costs no search and one that meets it is

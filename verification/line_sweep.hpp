@@ -7,9 +7,11 @@
 // sweeps a convex volume (the Minkowski sum of the piece and the segment), so a line meets
 // it in one interval of its parameter. That interval is computed:
 //  - in closed form for a cylinder moved level or along its axis (a 2D capsule or disc in
-//    XY within a Z slab) and for a whole sphere or ellipsoid moved in any direction (a 3D
-//    capsule, the ellipsoid's after scaling Z);
-//  - otherwise (a torus, a cylinder on a ramp, a sphere cut by its slab) as the sublevel
+//    XY within a Z slab), for a cylinder on a ramp (the extremes of a convex region of the
+//    line's and the segment's parameters: half-planes and one quadratic), and for a whole
+//    sphere or ellipsoid moved in any direction (a 3D capsule, the ellipsoid's after
+//    scaling Z);
+//  - otherwise (a torus off the level and the vertical, a sphere cut by its slab) as the sublevel
 //    set {g <= 0} of the convex function g(t) = min over the segment of the piece's convex
 //    gauge at the line's point: golden-section search for the minimum and bisection for
 //    the two ends, to about 1e-9 mm.

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 namespace hybridctl::verification {
@@ -96,8 +97,32 @@ TEST(LineInSweep, APlungeSweepsTheCylinderFromTheLowestTipToTheHighestTop) {
   EXPECT_NEAR(s.hi, 10 + std::sqrt(3.0), 1e-12);
 }
 
-TEST(LineInSweep, ARampTakesTheGeneralConvexSearch) {
+// A cylinder on a ramp in closed form: random lines, and the lines a surface's vectors
+// most often are (straight down, level along the ramp, level across it), on ramps that
+// climb, descend, run steep and nearly level, with a shank that never ends.
+TEST(LineInSweep, ACylinderOnARampAgreesWithTheDefinition) {
   check_against_definition(cylinder(1.5, 0, 3), {{-3, 0, -1}, {3, 1, 1.5}}, 3);
+  check_against_definition(cylinder(2, 0.5, 4), {{2, 2, 2}, {-1, -3, -2}}, 4);
+  check_against_definition(cylinder(1, 0, 2), {{0, 0, 0}, {0.3, 0.2, 4}}, 5);
+  check_against_definition(cylinder(2.5, 0, 1), {{-4, 1, 0}, {4, 1, 0.01}}, 6);
+  check_against_definition(cylinder(1, 3, std::numeric_limits<double>::infinity()), {{-3, 0, -4}, {3, 1, -2}}, 7);
+  const sim::Segment ramp{{0, 0, 0}, {10, 0, 2}};  // 10 mm along X, 2 up
+  const sim::ConvexPiece flute = cylinder(3, 0, 5);
+  // Straight down at x = 5 in the middle: the cylinder passed there with its tip at z = 1
+  // (s = 0.5), and from x = 2 (tip at 0.4) to x = 8 (tip at 1.6) it covers x = 5.
+  const Span down = line_in_sweep(flute, ramp, {5, 0, 20}, {0, 0, -1}, -100, 100);
+  EXPECT_NEAR(down.lo, 20 - (1.6 + 5), 1e-9);
+  EXPECT_NEAR(down.hi, 20 - 0.4, 1e-9);
+  // Level along X at z = 0.2: the tip is below 0.2 up to s = 0.1 (x = 1), so from x = -3 to 4.
+  const Span along = line_in_sweep(flute, ramp, {-10, 0, 0.2}, {1, 0, 0}, -100, 100);
+  EXPECT_NEAR(along.lo, 7, 1e-9);
+  EXPECT_NEAR(along.hi, 14, 1e-9);
+  // Level across at x = 5, z = 6.5: the top (tip + 5) reaches 6.5 from s = 0.75 (x = 7.5),
+  // 2.5 mm away, so |y| <= sqrt(9 - 6.25).
+  const Span across = line_in_sweep(flute, ramp, {5, -10, 6.5}, {0, 1, 0}, -100, 100);
+  EXPECT_NEAR(across.lo, 10 - std::sqrt(2.75), 1e-9);
+  EXPECT_NEAR(across.hi, 10 + std::sqrt(2.75), 1e-9);
+  EXPECT_TRUE(line_in_sweep(flute, ramp, {10, -10, 7.5}, {0, 1, 0}, -100, 100).empty());  // over the top's 7
 }
 
 TEST(LineInSweep, ABallSweepsACapsuleInAnyDirection) {
