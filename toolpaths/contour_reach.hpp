@@ -18,13 +18,10 @@
 #include <vector>
 
 #include "geometry/solid.hpp"
+#include "toolpaths/point2.hpp"
 #include "toolpaths/slices.hpp"
 
 namespace hybridctl::toolpaths {
-
-struct Point2 {
-  double x = 0, y = 0;
-};
 
 struct EdgeReach {
   // How far sideways (mm) a pass lays material at every voxel centre of the layer: the

@@ -33,13 +33,9 @@
 
 #include "config/machine.hpp"
 #include "geometry/mesh.hpp"
+#include "toolpaths/point2.hpp"
 
 namespace hybridctl::toolpaths {
-
-struct Point2 {
-  double x = 0, y = 0;
-  friend bool operator==(const Point2&, const Point2&) = default;
-};
 
 // Radius `radius` over [from, to] mm above the tip; `to` may be infinity.
 struct ToolBand {
