@@ -148,30 +148,40 @@ double argmin_convex(F f, double a, double b, int iterations) {
   return f1 <= f2 ? x1 : x2;
 }
 
-// {t in [t0, t1] : g(t) <= 0} for a convex g: one interval. A coarse scan brackets the
-// minimum first, which also keeps a g that is only piecewise convex from misleading the
-// search.
+// {t in [t0, t1] : g(t) <= 0} for a convex g: one interval. The line meets a convex
+// volume in one interval, so a point found inside (an end, or a point of a coarse scan)
+// is where both edges are searched from; only when none is, the minimum is searched for,
+// bracketed by the scan (which also keeps a g that is only piecewise convex from
+// misleading the search).
 template <class G>
 Span sublevel(G g, double t0, double t1) {
-  constexpr int kScan = 16;
-  int best = 0;
-  double lowest = g(t0);
-  for (int k = 1; k <= kScan; ++k) {
-    const double v = g(t0 + (t1 - t0) * k / kScan);
-    if (v < lowest) lowest = v, best = k;
-  }
-  const double step = (t1 - t0) / kScan;
-  const double tm = argmin_convex(g, std::max(t0, t0 + (best - 1) * step), std::min(t1, t0 + (best + 1) * step), 32);
-  if (g(tm) > 0) return none();
-  auto edge = [&](double outside, double inside) {
-    if (g(outside) <= 0) return outside;
+  const double g0 = g(t0), g1 = g(t1);
+  auto edge = [&](double outside, double g_outside, double inside) {
+    if (g_outside <= 0) return outside;
     for (int i = 0; i < 34 && std::abs(inside - outside) > 1e-9; ++i) {
       const double mid = 0.5 * (inside + outside);
       (g(mid) <= 0 ? inside : outside) = mid;
     }
     return inside;
   };
-  return {edge(t0, tm), edge(t1, tm)};
+  if (g0 <= 0 || g1 <= 0) {
+    const double inside = g0 <= 0 ? t0 : t1;
+    return {edge(t0, g0, inside), edge(t1, g1, inside)};
+  }
+  constexpr int kScan = 16;
+  int best = 0;
+  double lowest = g0;
+  for (int k = 1; k < kScan; ++k) {
+    const double tk = t0 + (t1 - t0) * k / kScan;
+    const double v = g(tk);
+    if (v <= 0) return {edge(t0, g0, tk), edge(t1, g1, tk)};
+    if (v < lowest) lowest = v, best = k;
+  }
+  if (g1 < lowest) best = kScan;
+  const double step = (t1 - t0) / kScan;
+  const double tm = argmin_convex(g, std::max(t0, t0 + (best - 1) * step), std::min(t1, t0 + (best + 1) * step), 32);
+  if (g(tm) > 0) return none();
+  return {edge(t0, g0, tm), edge(t1, g1, tm)};
 }
 
 // Whether the stretch [t0, t1] of the line surely misses the sweep: it lies above or below

@@ -13,8 +13,9 @@
 //    scaling Z);
 //  - otherwise (a torus off the level and the vertical, a sphere cut by its slab) as the sublevel
 //    set {g <= 0} of the convex function g(t) = min over the segment of the piece's convex
-//    gauge at the line's point: golden-section search for the minimum and bisection for
-//    the two ends, to about 1e-9 mm.
+//    gauge at the line's point: bisection for the two ends, to about 1e-9 mm, from a point
+//    inside (an end of the stretch asked about, a point of a coarse scan, or else the
+//    minimum, found by golden-section search).
 
 #include <span>
 #include <vector>
