@@ -89,7 +89,7 @@ std::string joined(const std::vector<std::string>& names, const char* last = " a
 // shop sees (a whole cavity, a whole slot), however the atoms split it. `id` (its first
 // voxel in the domain's order) tells one from another. None when it reaches the domain's
 // edge and `closed` asks for a closed space (the way out bends round the part), or when it
-// is larger than `cap` voxels.
+// is larger than kCap voxels.
 struct AirBody {
   std::int64_t id = -1;
   std::int64_t voxels = 0;
@@ -246,8 +246,9 @@ AirWords air_in_words(const config::Machine& machine, const PlanningResult& r, c
       return w >= 0 && w < smallest->diameter - 1e-9;
     };
     std::string slot_volume = volume;
-    if (side == kDirections.end()) {
-    } else if (const std::optional<AirBody> slot = air_body(r, voxels, false, narrow)) {
+    const std::optional<AirBody> slot =
+        side == kDirections.end() ? std::nullopt : air_body(r, voxels, false, narrow);
+    if (slot) {
       said.body = slot->id;
       said.air = double(slot->voxels) * h * h * h;
       at = said.at = slot->at;
