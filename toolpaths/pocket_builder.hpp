@@ -166,7 +166,9 @@ class PocketBuilder {
   // Surface finishing (pocket_surface.cpp): ball and bull noses on the design's STL.
   // `region`: what the action may remove; the faces next to it are finished.
   void start_surface_finishing(const Solid& region, const Solid* design);
+  Solid stays_besides_design() const;
   void finish_surfaces();
+  double finish_surface_rows(const CellBox& box, bool along_x, double steep_cos);
   // The lowest tip height at p clear of the design's surface, of what must stay that is
   // not design, and with the body clear of all material; -infinity when nothing is there.
   double surface_tip_at(Point2 p) const;
@@ -195,6 +197,11 @@ class PocketBuilder {
   IndexBox all_;             // every voxel of the ROI, keep and stock
   IndexBox work_;            // tip domain
   Solid remaining_, untouchable_;
+  // What must stay that the exact finishing passes must not cut either: what stays, less
+  // the design (the STL keeps the passes off it) and the material within a voxel of it (the
+  // band the plan leaves free: taking it only brings the part closer to the STL). Set when
+  // finishing starts (stays_besides_design).
+  Solid stays_;
   IndexBox tops_box_;
   std::vector<int> tops_, untouchable_tops_;
   double safe_z_ = 0;

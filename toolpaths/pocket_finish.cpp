@@ -107,6 +107,7 @@ void PocketBuilder::start_finishing(const Solid& region, const Solid* design) {
   finish_bands_ = flat_tool_bands(tool_);
   if (finish_bands_.empty()) return;
   roi_ = region;
+  stays_ = stays_besides_design();
   // The heights of the design's faces square to the tool axis, either way up: where a wall
   // ends, finished from there when no level is (the flange's rim above the stock kept
   // under it: the level below would reach into that stock).
@@ -358,7 +359,7 @@ std::optional<FinishLevel> PocketBuilder::finish_level(const TipKeepOut& keep_ou
   for (int kk = k; kk < k_above; ++kk) roi_here |= slice_of(roi_, kk, work_);
   for (int kk = c0; kk <= c1; ++kk) {
     const SliceMask u = slice_of(untouchable_, kk, work_), d = slice_of(design_, kk, work_);
-    f.held |= u.without(d);
+    f.held |= slice_of(stays_, kk, work_);
     SliceMask kept = u;
     kept &= d;
     kept_design |= kept;

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "geometry/morphology.hpp"
 #include "geometry/sliding_extremum.hpp"
 #include "geometry/voxelize.hpp"
 #include "toolpaths/pocket_builder.hpp"
@@ -65,9 +66,10 @@ void PocketBuilder::start_surface_finishing(const Solid& region, const Solid* de
                                           geometry::VoxelizeMethod::ExactScan);
   const CutterShape shape = cutter_shape(tool_);
   surface_step_over_ = std::min(step_over_, scallop_step_over(shape, options_.scallop));
-  // What must stay is an obstacle on the voxels, except the design's own voxels: the
-  // design is the STL, and its voxels reach up to half a voxel past it.
-  obstacle_tops_ = column_top_indices(geometry::subtract(untouchable_, design_), tops_box_);
+  // What must stay is an obstacle on the voxels, except the design's own voxels (the
+  // design is the STL, and its voxels reach up to half a voxel past it) and those beside them.
+  stays_ = stays_besides_design();
+  obstacle_tops_ = column_top_indices(stays_, tops_box_);
   const int tnx = tops_box_.hi.x - tops_box_.lo.x, tny = tops_box_.hi.y - tops_box_.lo.y;
   obstacle_near_ = max_within(obstacle_tops_, tnx, tny, int(std::ceil(shape.radius / h_)) + 1);
   // Material only goes from here on: the highest now bounds it for the whole run.
@@ -108,6 +110,12 @@ void PocketBuilder::start_surface_finishing(const Solid& region, const Solid* de
     for (int x = work_.lo.x; x < work_.hi.x; ++x)
       rough_tips_[std::size_t(y - work_.lo.y) * std::size_t(work_.hi.x - work_.lo.x) + std::size_t(x - work_.lo.x)] =
           rough.tip_height({lattice_.origin.x + (x + 0.5) * h_, lattice_.origin.y + (y + 0.5) * h_}) + kRoughLeave;
+}
+
+geometry::Solid PocketBuilder::stays_besides_design() const {
+  // Face, edge and corner neighbours: within sqrt(3) voxels.
+  const Solid beside = geometry::dilate(design_, geometry::Ball{1.75 * h_});
+  return geometry::subtract(geometry::subtract(untouchable_, design_), beside);
 }
 
 SliceMask PocketBuilder::under_surface(double z) const {
@@ -265,38 +273,67 @@ void PocketBuilder::cut_surface_pass(const std::vector<Vec3>& pts, const std::ve
   spindle_ = 0;
 }
 
+// Rows along X first. Where the surface is steep across them (a fillet or a wall along
+// X), the scallop between two rows widens as 1 / cos^2 of the slope across: there a second
+// raster, rows along Y, follows the slope instead (docs/toolpaths.md, "Surface finishing").
 void PocketBuilder::finish_surfaces() {
   if (!drop_) return;
   const CellBox box = cell_bounds(surface_domain_);
   if (box.empty()) return;
+  const double step = finish_surface_rows(box, true, 0);
+  // X rows `step` apart leave at most 1.5 scallops where the slope across them has a
+  // cosine of at least this; steeper, the Y rows finish.
+  const double steep_cos = step / scallop_step_over(drop_->shape(), 1.5 * options_.scallop);
+  if (steep_cos < 1) finish_surface_rows(box, false, steep_cos);
+  retract();
+}
+
+// One raster over the domain's box: rows along X (`along_x`) or along Y, `surface_step_over_`
+// apart at most. With `steep_cos` > 0, only where the tip surface's slope across X rows has
+// a cosine below it. Returns the step between rows.
+double PocketBuilder::finish_surface_rows(const CellBox& box, bool along_x, double steep_cos) {
   const double xa = lattice_.origin.x + box.x0 * h_, xb = lattice_.origin.x + box.x1 * h_ - 1e-6;
   const double ya = lattice_.origin.y + box.y0 * h_, yb = lattice_.origin.y + box.y1 * h_ - 1e-6;
-  const int rows = std::max(1, int(std::ceil((yb - ya) / surface_step_over_))) + 1;
-  const double dy = (yb - ya) / (rows - 1);
+  // u along the rows, v across them.
+  const double ua = along_x ? xa : ya, ub = along_x ? xb : yb, va = along_x ? ya : xa, vb = along_x ? yb : xb;
+  const auto at = [&](double u, double v) { return along_x ? Point2{u, v} : Point2{v, u}; };
+  const int rows = std::max(1, int(std::ceil((vb - va) / surface_step_over_))) + 1;
+  const double dv = rows > 1 ? (vb - va) / (rows - 1) : 0.0;
   const double sample = std::min({0.25, h_ / 2, surface_step_over_});
-  pending_comment_ = "surface finishing: drop-cutter rows " + mm(dy) + " mm apart on the STL";
+  // The tip surface's slope across X rows at p, as the cosine of its angle.
+  const auto steep = [&](Point2 p) {
+    if (!(steep_cos > 0)) return true;
+    const double d = sample / 2;
+    const double z0 = drop_->tip_height({p.x, p.y - d}), z1 = drop_->tip_height({p.x, p.y + d});
+    if (!std::isfinite(z0) || !std::isfinite(z1)) return false;
+    const double slope = (z1 - z0) / (2 * d);
+    return 1 / std::sqrt(1 + slope * slope) < steep_cos;
+  };
+  pending_comment_ = "surface finishing: drop-cutter rows along " + std::string(along_x ? "X " : "Y ") + mm(dv) +
+                     " mm apart on the STL" + (steep_cos > 0 ? ", where the surface is steep across X" : "");
   bool forward = true;
   for (int r = 0; r < rows; ++r) {
-    const double y = ya + r * dy;
+    const double v = va + r * dv;
     // The row's stretches over the domain, in the direction of travel.
     std::vector<std::pair<double, double>> stretches;
-    const int n = std::max(1, int(std::ceil((xb - xa) / sample)));
+    const int n = std::max(1, int(std::ceil((ub - ua) / sample)));
     double start = 0;
     bool inside = false;
     for (int i = 0; i <= n; ++i) {
-      const double x = xa + (xb - xa) * i / n;
-      const bool in = in_surface_domain({x, y});
-      if (in && !inside) start = x;
-      if (!in && inside) stretches.emplace_back(start, xa + (xb - xa) * (i - 1) / n);
+      const double u = ua + (ub - ua) * i / n;
+      const bool in = in_surface_domain(at(u, v)) && steep(at(u, v));
+      if (in && !inside) start = u;
+      if (!in && inside) stretches.emplace_back(start, ua + (ub - ua) * (i - 1) / n);
       inside = in;
     }
-    if (inside) stretches.emplace_back(start, xb);
+    if (inside) stretches.emplace_back(start, ub);
     if (!forward) {
       std::reverse(stretches.begin(), stretches.end());
       for (auto& [a, b] : stretches) std::swap(a, b);
     }
     for (const auto& [a, b] : stretches) {
-      const std::vector<Vec3> line = surface_line({a, y}, {b, y});
+      if (std::abs(b - a) < 1e-9) continue;
+      const std::vector<Vec3> line = surface_line(at(a, v), at(b, v));
       // Passes: the line's finite runs (nothing under the cutter, or no room for it, ends one).
       std::size_t i = 0;
       while (i < line.size()) {
@@ -319,7 +356,7 @@ void PocketBuilder::finish_surfaces() {
     }
     forward = !forward;
   }
-  retract();
+  return dv;
 }
 
 }  // namespace hybridctl::toolpaths::pocket

@@ -53,6 +53,7 @@
 #include "plan/deviation.hpp"
 #include "plan/plan_file.hpp"
 #include "plan/start_stock.hpp"
+#include "independent_part.hpp"
 #include "verification/exact_deviation.hpp"
 
 namespace {
@@ -66,7 +67,8 @@ const fs::path kSource = HYBRIDCTL_SOURCE_DIR;
 const fs::path kPart = kSource / "examples/parts/flanged-hub.stl";
 const fs::path kMachine = kSource / "examples/machines/hybrid-3axis.yaml";
 constexpr double kAgree = 0.01;  // mm: the issue's bar
-constexpr double kPi = 3.14159265358979323846;
+using verification::independent::kPi;
+namespace independent = verification::independent;
 
 // ---------------------------------------------------------------------------------------
 // The program as LinuxCNC's interpreter reads it.
@@ -76,15 +78,9 @@ constexpr double kPi = 3.14159265358979323846;
 // (docs/machine-file.md: program coordinates + work_origin = machine coordinates); it
 // prints them to 4 decimals, and this program's are quarter millimetres. Its G53 retracts
 // (machine Z 300) read as work Z 300: far above the part either way.
-struct Cut {
+struct Cut : independent::CanonicalMove {
   config::Approach approach = config::Approach::PlusZ;  // of the setup it runs in
-  int action = 0;        // the heading comment's number
   double radius = 0, flute = 0;
-  Vec3 from, to;
-  bool arc = false;
-  // Arcs (XY plane): centre, radius, start angle and signed sweep (counter-clockwise > 0);
-  // z goes linearly with the angle from from.z to to.z.
-  double cx = 0, cy = 0, r = 0, a0 = 0, sweep = 0;
 };
 
 struct Canonical {
@@ -95,89 +91,32 @@ struct Canonical {
   int other_setups = 0;   // moves in a work offset of no setup, or of one not from +Z or -Z
 };
 
-std::vector<std::string> arguments(const std::string& line) {
-  const std::size_t open = line.find('('), close = line.rfind(')');
-  std::vector<std::string> out;
-  std::stringstream s(line.substr(open + 1, close - open - 1));
-  for (std::string item; std::getline(s, item, ',');) out.push_back(item);
-  return out;
-}
-
-double number(const std::string& s) { return std::stod(s); }
-
-// Reads rs274's canonical calls. A move's start is where the previous one ended; the first
-// move starts at rs274's assumed origin, which the program never commanded, so it is not
-// swept (it is the G53 retract straight up, nowhere near the part).
-Canonical read_canonical(const std::string& text, const config::Machine& machine) {
+// The moves of cutting tools, from rs274's canonical calls (independent_part.hpp).
+Canonical read_cuts(const std::string& text, const config::Machine& machine) {
+  const independent::CanonicalProgram program = independent::read_canonical(text);
   Canonical out;
-  Vec3 at;
-  bool known = false;  // where the tool is
-  int selected = 0, tool = 0, offset = 54, action = 0;
-  bool xy_plane = true;
-  std::istringstream in(text);
-  for (std::string line; std::getline(in, line);) {
-    const std::size_t open = line.find('(');
-    if (open == std::string::npos) continue;
-    const std::size_t start = line.rfind(' ', open) + 1;
-    const std::string call = line.substr(start, open - start);
-    if (call == "COMMENT") {
-      int k = 0;
-      if (std::sscanf(line.c_str() + open, "(\"action %d:", &k) == 1) action = k;
-      continue;
-    }
-    if (call == "SELECT_TOOL") selected = int(number(arguments(line)[0]));
-    if (call == "CHANGE_TOOL") tool = selected;
-    if (call == "SET_G5X_OFFSET") offset = 53 + int(number(arguments(line)[0]));
-    if (call == "SELECT_PLANE") xy_plane = line.find("CANON_PLANE_XY") != std::string::npos;
-    if (call == "SET_AUX_OUTPUT_BIT") ++out.deposits;
-    const bool line_move = call == "STRAIGHT_TRAVERSE" || call == "STRAIGHT_FEED";
-    if (!line_move && call != "ARC_FEED") continue;
-    const std::vector<std::string> a = arguments(line);
-    Vec3 end;
-    Cut cut;
-    if (line_move) {
-      end = {number(a[0]), number(a[1]), number(a[2])};
+  out.deposits = program.deposits;
+  out.other_planes = program.other_planes;
+  for (const independent::CanonicalMove& move : program.moves) {
+    if (move.tool == 0) continue;
+    const auto t = std::find_if(machine.tools.begin(), machine.tools.end(),
+                                [&](const config::CuttingTool& c) { return c.number == move.tool; });
+    const auto setup = std::find_if(machine.setups.begin(), machine.setups.end(),
+                                    [&](const config::Setup& s) { return s.work_offset == move.work_offset; });
+    if (t == machine.tools.end()) {
+      // A head, which lays nothing unless its output is on (counted by the reader).
+    } else if (t->type != config::ToolType::Flat) {
+      ++out.other_cutters;
+    } else if (setup == machine.setups.end() ||
+               (setup->approach != config::Approach::PlusZ && setup->approach != config::Approach::MinusZ)) {
+      ++out.other_setups;
     } else {
-      if (!xy_plane) {
-        ++out.other_planes;
-        known = false;
-        continue;
-      }
-      end = {number(a[0]), number(a[1]), number(a[5])};
-      cut.arc = true;
-      cut.cx = number(a[2]), cut.cy = number(a[3]);
-      const int turns = int(number(a[4]));
-      if (known) {
-        cut.r = std::hypot(at.x - cut.cx, at.y - cut.cy);
-        cut.a0 = std::atan2(at.y - cut.cy, at.x - cut.cx);
-        const double a1 = std::atan2(end.y - cut.cy, end.x - cut.cx);
-        // rs274: the sign of `turns` is the direction, |turns| - 1 the whole turns added.
-        double d = turns > 0 ? a1 - cut.a0 : cut.a0 - a1;
-        while (d <= 1e-12) d += 2 * kPi;
-        d += (std::abs(turns) - 1) * 2 * kPi;
-        cut.sweep = turns > 0 ? d : -d;
-      }
+      Cut cut;
+      static_cast<independent::CanonicalMove&>(cut) = move;
+      cut.approach = setup->approach;
+      cut.radius = t->diameter / 2, cut.flute = t->flute_length;
+      out.cuts.push_back(cut);
     }
-    if (known && tool > 0) {
-      const auto t = std::find_if(machine.tools.begin(), machine.tools.end(),
-                                  [&](const config::CuttingTool& c) { return c.number == tool; });
-      const auto setup = std::find_if(machine.setups.begin(), machine.setups.end(),
-                                      [&](const config::Setup& s) { return s.work_offset == offset; });
-      if (t == machine.tools.end()) {
-        // A head, which lays nothing unless its output is on (counted above).
-      } else if (t->type != config::ToolType::Flat) {
-        ++out.other_cutters;
-      } else if (setup == machine.setups.end() || (setup->approach != config::Approach::PlusZ &&
-                                                   setup->approach != config::Approach::MinusZ)) {
-        ++out.other_setups;
-      } else {
-        cut.approach = setup->approach, cut.action = action;
-        cut.radius = t->diameter / 2, cut.flute = t->flute_length;
-        cut.from = at, cut.to = end;
-        out.cuts.push_back(cut);
-      }
-    }
-    at = end, known = true;
   }
   return out;
 }
@@ -211,12 +150,6 @@ void circle_crossings(const Ray& ray, double cx, double cy, double rho, std::vec
   out.push_back(-b + std::sqrt(disc));
 }
 
-double segment_distance(double px, double py, double ax, double ay, double bx, double by) {
-  const double vx = bx - ax, vy = by - ay, l2 = vx * vx + vy * vy;
-  const double t = l2 > 0 ? std::clamp(((px - ax) * vx + (py - ay) * vy) / l2, 0.0, 1.0) : 0.0;
-  return std::hypot(px - ax - t * vx, py - ay - t * vy);
-}
-
 double arc_distance(double px, double py, double cx, double cy, double r, double a0, double sweep) {
   const double ring = std::abs(std::hypot(px - cx, py - cy) - r);
   if (std::abs(sweep) >= 2 * kPi) return ring;
@@ -230,10 +163,8 @@ double arc_distance(double px, double py, double cx, double cy, double r, double
                   std::hypot(px - cx - r * std::cos(a1), py - cy - r * std::sin(a1)));
 }
 
-struct Interval {
-  double lo = 0, hi = 0;
-  int action = 0;
-};
+using Interval = independent::Removal;
+using Figures = independent::RayFigures;
 
 // The parameter range [t0, t1] of a move (0..1 along it) over which a cutter whose tip
 // is at z(t) spans height h with its flutes: z(t) <= h <= z(t) + flute.
@@ -264,7 +195,7 @@ void ray_in_cut(const Ray& ray, double lo, double hi, const Cut& cut, double h, 
     const double by = cut.from.y + span->second * (cut.to.y - cut.from.y);
     // Far from the ray's reach: nothing to do.
     const double mx = 0.5 * (ray.x(lo) + ray.x(hi)), my = 0.5 * (ray.y(lo) + ray.y(hi));
-    if (segment_distance(mx, my, ax, ay, bx, by) > rad + 0.5 * (hi - lo) + 1e-6) return;
+    if (independent::segment_distance_2d(mx, my, ax, ay, bx, by) > rad + 0.5 * (hi - lo) + 1e-6) return;
     circle_crossings(ray, ax, ay, rad, breaks);
     circle_crossings(ray, bx, by, rad, breaks);
     const double len = std::hypot(bx - ax, by - ay);
@@ -275,7 +206,7 @@ void ray_in_cut(const Ray& ray, double lo, double hi, const Cut& cut, double h, 
       if (std::abs(across) > 1e-15)
         for (double side : {-rad, rad}) breaks.push_back((side - at0) / across);
     }
-    distance = [=](double x, double y) { return segment_distance(x, y, ax, ay, bx, by); };
+    distance = [=](double x, double y) { return independent::segment_distance_2d(x, y, ax, ay, bx, by); };
   } else {
     const double a0 = cut.a0 + span->first * cut.sweep, sweep = (span->second - span->first) * cut.sweep;
     const double cx = cut.cx, cy = cut.cy, r = cut.r;
@@ -299,70 +230,7 @@ void ray_in_cut(const Ray& ray, double lo, double hi, const Cut& cut, double h, 
 }
 
 // ---------------------------------------------------------------------------------------
-// 3D: distance to the design's triangles (Ericson, Real-Time Collision Detection, 5.1.5).
-
-Vec3 sub(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-Vec3 lerp(Vec3 a, Vec3 b, double t) { return {a.x + t * (b.x - a.x), a.y + t * (b.y - a.y), a.z + t * (b.z - a.z)}; }
-
-Vec3 closest_on_triangle(Vec3 p, Vec3 a, Vec3 b, Vec3 c) {
-  const Vec3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
-  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
-  if (d1 <= 0 && d2 <= 0) return a;
-  const Vec3 bp = sub(p, b);
-  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
-  if (d3 >= 0 && d4 <= d3) return b;
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return lerp(a, b, d1 / (d1 - d3));
-  const Vec3 cp = sub(p, c);
-  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
-  if (d6 >= 0 && d5 <= d6) return c;
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return lerp(a, c, d2 / (d2 - d6));
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) return lerp(b, c, (d4 - d3) / ((d4 - d3) + (d5 - d6)));
-  const double denom = 1 / (va + vb + vc);
-  const double v = vb * denom, w = vc * denom;
-  return {a.x + ab.x * v + ac.x * w, a.y + ab.y * v + ac.y * w, a.z + ab.z * v + ac.z * w};
-}
-
-double mesh_distance(const geometry::TriangleMesh& mesh, Vec3 p) {
-  double best = std::numeric_limits<double>::infinity();
-  for (const geometry::Triangle& t : mesh.triangles) {
-    const Vec3 q = closest_on_triangle(p, t[0], t[1], t[2]);
-    best = std::min(best, std::sqrt(dot(sub(p, q), sub(p, q))));
-  }
-  return best;
-}
-
-// The STL cut by the plane z = h: its segments, each with the triangle's unit normal
-// projected (horizontal for the walls), in the part frame.
-struct SectionEdge {
-  double ax, ay, bx, by;
-};
-std::vector<SectionEdge> stl_section(const geometry::TriangleMesh& mesh, double h) {
-  std::vector<SectionEdge> out;
-  for (const geometry::Triangle& t : mesh.triangles) {
-    std::vector<std::pair<double, double>> points;
-    for (int i = 0; i < 3; ++i) {
-      const Vec3 a = t[i], b = t[(i + 1) % 3];
-      if ((a.z - h) * (b.z - h) < 0) {
-        const double s = (h - a.z) / (b.z - a.z);
-        points.push_back({a.x + s * (b.x - a.x), a.y + s * (b.y - a.y)});
-      }
-    }
-    if (points.size() == 2) out.push_back({points[0].first, points[0].second, points[1].first, points[1].second});
-  }
-  return out;
-}
-
-// ---------------------------------------------------------------------------------------
 // The independent figures at one wall sample.
-
-struct Figures {
-  double excess = 0, gouge = 0;
-  std::set<int> surface_actions;  // whose cut made the surface under the sample (0: the stock)
-};
 
 struct Model {
   const geometry::TriangleMesh* mesh = nullptr;
@@ -393,47 +261,7 @@ Figures measure(const Model& model, Vec3 p, Vec3 n, double inward, double outwar
     const Vec3 wp = to_work(p, cut.approach), wn = to_work(n, cut.approach);
     ray_in_cut(Ray{wp.x, wp.y, wn.x, wn.y}, lo, hi, cut, wp.z, removed);
   }
-  // Runs of material: [s0, s1] less the union of the removed intervals.
-  std::sort(removed.begin(), removed.end(), [](const Interval& a, const Interval& b) { return a.lo < b.lo; });
-  struct Run {
-    double lo, hi;
-    std::set<int> hi_actions;
-  };
-  std::vector<Run> runs;
-  double from = s0;
-  std::size_t k = 0;
-  while (from < s1) {
-    // The next removal that reaches past `from`.
-    while (k < removed.size() && removed[k].hi <= from) ++k;
-    if (k == removed.size()) {
-      runs.push_back({from, s1, {0}});
-      break;
-    }
-    if (removed[k].lo > from) {
-      const double end = std::min(removed[k].lo, s1);
-      std::set<int> by;
-      for (const Interval& r : removed)
-        if (std::abs(r.lo - end) < 1e-7) by.insert(r.action);
-      runs.push_back({from, end, end < s1 ? by : std::set<int>{0}});
-    }
-    // Skip the covered stretch: removals chained from here on.
-    double covered = std::max(from, removed[k].hi);
-    for (std::size_t j = k; j < removed.size() && removed[j].lo <= covered; ++j)
-      covered = std::max(covered, removed[j].hi);
-    from = covered;
-  }
-  Figures f;
-  const auto at = [&](double s) { return Vec3{p.x + s * n.x, p.y + s * n.y, p.z + s * n.z}; };
-  if (!runs.empty() && runs.back().hi > 1e-9) f.excess = mesh_distance(*model.mesh, at(runs.back().hi));
-  const Run* under = nullptr;
-  for (const Run& r : runs)
-    if (r.lo <= 0) under = &r;
-  double deepest = 1;
-  if (!under) deepest = lo;
-  else if (under->hi < -1e-9) deepest = under->hi;
-  if (deepest < 0) f.gouge = mesh_distance(*model.mesh, at(deepest));
-  f.surface_actions = under ? under->hi_actions : std::set<int>{};
-  return f;
+  return independent::ray_figures(*model.mesh, p, n, inward, s0, s1, std::move(removed));
 }
 
 // The arcs' sweep above is not needed by this plan's program (lines only), so it is checked
@@ -506,9 +334,8 @@ class HubSections : public ::testing::Test {
     h.dir = fs::temp_directory_path() / ("hybridctl-hub-sections-" + std::to_string(::getpid()));
     fs::remove_all(h.dir);
     fs::create_directories(h.dir);
-    if (!fs::exists(kSource / ".peers/linuxcnc/usr/bin/rs274")) {
-      h.failure = "LinuxCNC's rs274 is missing from .peers/linuxcnc: run scripts/setup (it downloads linuxcnc-uspace "
-                  "and libboost-python1.74.0 with apt-get download and unpacks them there)";
+    if (const std::string missing = independent::rs274_missing(kSource); !missing.empty()) {
+      h.failure = missing;
       return;
     }
     // The machine file's own settings (tolerance 0.5 mm, voxel 0.5 mm): the plan `plan`
@@ -521,10 +348,8 @@ class HubSections : public ::testing::Test {
       h.failure = "hybridctl plan failed:\n" + planned.out + planned.err;
       return;
     }
-    const Outcome canonical = run_shell(quote((kSource / "scripts/rs274").string()) + " -t " +
-                                            quote((h.dir / "out/tool.tbl").string()) + " -g " +
-                                            quote((h.dir / "out/plan-1.ngc").string()),
-                                        h.dir);
+    const Outcome canonical =
+        run_shell(independent::rs274_command(kSource, h.dir / "out/tool.tbl", h.dir / "out/plan-1.ngc"), h.dir);
     if (canonical.exit_code != 0) {
       h.failure = "rs274 refused plan-1.ngc:\n" + canonical.err.substr(0, 2000);
       return;
@@ -544,7 +369,7 @@ class HubSections : public ::testing::Test {
                                               {h.file.tolerance});
 
     // The independent side.
-    const Canonical c = read_canonical(canonical.out, h.machine);
+    const Canonical c = read_cuts(canonical.out, h.machine);
     if (c.deposits > 0 || c.other_planes > 0 || c.other_cutters > 0 || c.other_setups > 0) {
       h.failure = "the plan's program is not what this test models (flat end mills from +Z or -Z, XY arcs, no bead): " +
                   std::to_string(c.deposits) + " deposits, " + std::to_string(c.other_planes) + " arcs out of XY, " +
@@ -660,8 +485,8 @@ TEST_F(HubSections, EveryWallSampleAtTheSectionsHasTheExcessAndGougeTheCuttersSw
       // wall, outward; its vector reaches as far as the sampling says (the design has
       // nothing else near it).
       double on = 1e9;
-      for (const SectionEdge& e : stl_section(h.mesh, s.point.z))
-        on = std::min(on, segment_distance(s.point.x, s.point.y, e.ax, e.ay, e.bx, e.by));
+      for (const independent::SectionEdge& e : independent::mesh_section(h.mesh, 2, s.point.z))
+        on = std::min(on, independent::segment_distance_2d(s.point.x, s.point.y, e.a0, e.b0, e.a1, e.b1));
       EXPECT_LT(on, 1e-6);
       EXPECT_GT((s.point.x - 25) * s.normal.x + (s.point.y - 25) * s.normal.y, 0);
       EXPECT_DOUBLE_EQ(s.inward, sampling.reach);
@@ -698,14 +523,15 @@ TEST_F(HubSections, EachSectionsLargestExcessAndGougeAreTheOnesTheProductReports
   const double reach = h.surface->options().reach;
   for (const Height& height : kHeights) {
     SCOPED_TRACE(std::string(height.where) + " at z " + std::to_string(height.z));
-    const std::vector<SectionEdge> section = stl_section(h.mesh, height.z);
+    const std::vector<independent::SectionEdge> section = independent::mesh_section(h.mesh, 2, height.z);
     ASSERT_FALSE(section.empty());
     // The wall is a 48-gon round (25, 25): its section lies between the apothem and the
     // radius (the STL's vertices are single precision), and its outside is away from the axis.
     const double apothem = height.radius * std::cos(kPi / 48);
     double section_excess = 0, section_gouge = 0;
     Vec3 excess_at, gouge_at;
-    for (const SectionEdge& e : section) {
+    for (const independent::SectionEdge& edge : section) {
+      const struct { double ax, ay, bx, by; } e{edge.a0, edge.b0, edge.a1, edge.b1};
       for (const double r : {std::hypot(e.ax - 25, e.ay - 25), std::hypot(e.bx - 25, e.by - 25)}) {
         EXPECT_GE(r, apothem - 1e-4);
         EXPECT_LE(r, height.radius + 1e-4);
