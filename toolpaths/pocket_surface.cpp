@@ -284,7 +284,7 @@ void PocketBuilder::finish_surfaces() {
   // X rows `step` apart leave at most 1.5 scallops where the slope across them has a
   // cosine of at least this; steeper, the Y rows finish.
   const double steep_cos = step / scallop_step_over(drop_->shape(), 1.5 * options_.scallop);
-  if (steep_cos < 1) finish_surface_rows(box, false, steep_cos);
+  if (step > 0 && steep_cos < 1) finish_surface_rows(box, false, steep_cos);
   retract();
 }
 
