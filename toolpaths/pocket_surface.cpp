@@ -300,7 +300,8 @@ double PocketBuilder::finish_surface_rows(const CellBox& box, bool along_x, doub
   const int rows = std::max(1, int(std::ceil((vb - va) / surface_step_over_))) + 1;
   const double dv = rows > 1 ? (vb - va) / (rows - 1) : 0.0;
   const double sample = std::min({0.25, h_ / 2, surface_step_over_});
-  // The tip surface's slope across X rows at p, as the cosine of its angle.
+  // Whether the tip surface at p is steep across the X rows (the cosine of its slope there
+  // below steep_cos); every point when steep_cos is 0.
   const auto steep = [&](Point2 p) {
     if (!(steep_cos > 0)) return true;
     const double d = sample / 2;
