@@ -284,7 +284,7 @@ void PocketBuilder::finish_surfaces() {
   // X rows `step` apart leave at most 1.5 scallops where the slope across them has a
   // cosine of at least this; steeper, the Y rows finish.
   const double steep_cos = step / scallop_step_over(drop_->shape(), 1.5 * options_.scallop);
-  if (step > 0 && steep_cos < 1) finish_surface_rows(box, false, steep_cos);
+  if (steep_cos < 1) finish_surface_rows(box, false, steep_cos);
   retract();
 }
 
@@ -298,7 +298,7 @@ double PocketBuilder::finish_surface_rows(const CellBox& box, bool along_x, doub
   const double ua = along_x ? xa : ya, ub = along_x ? xb : yb, va = along_x ? ya : xa, vb = along_x ? yb : xb;
   const auto at = [&](double u, double v) { return along_x ? Point2{u, v} : Point2{v, u}; };
   const int rows = std::max(1, int(std::ceil((vb - va) / surface_step_over_))) + 1;
-  const double dv = rows > 1 ? (vb - va) / (rows - 1) : 0.0;
+  const double dv = (vb - va) / (rows - 1);  // rows >= 2, and the box is not empty
   const double sample = std::min({0.25, h_ / 2, surface_step_over_});
   // Whether the tip surface at p is steep across the X rows (the cosine of its slope there
   // below steep_cos); every point when steep_cos is 0.

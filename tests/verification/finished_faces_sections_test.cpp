@@ -317,9 +317,7 @@ class FinishedFacesSections : public ::testing::Test {
   static void SetUpTestSuite() {
     block_ = new Block;
     Block& b = *block_;
-    b.dir = fs::temp_directory_path() / ("hybridctl-finished-faces-" + std::to_string(::getpid()));
-    fs::remove_all(b.dir);
-    fs::create_directories(b.dir);
+    b.dir = independent::fresh_directory("hybridctl-finished-faces");
     if (const std::string missing = independent::rs274_missing(kSource); !missing.empty()) {
       b.failure = missing;
       return;

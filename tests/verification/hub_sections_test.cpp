@@ -331,9 +331,7 @@ class HubSections : public ::testing::Test {
   static void SetUpTestSuite() {
     hub_ = new Hub;
     Hub& h = *hub_;
-    h.dir = fs::temp_directory_path() / ("hybridctl-hub-sections-" + std::to_string(::getpid()));
-    fs::remove_all(h.dir);
-    fs::create_directories(h.dir);
+    h.dir = independent::fresh_directory("hybridctl-hub-sections");
     if (const std::string missing = independent::rs274_missing(kSource); !missing.empty()) {
       h.failure = missing;
       return;

@@ -6,6 +6,8 @@
 #include <limits>
 #include <sstream>
 
+#include <unistd.h>
+
 namespace hybridctl::verification::independent {
 namespace {
 
@@ -81,6 +83,13 @@ CanonicalProgram read_canonical(const std::string& text) {
     at = move.to, known = true;
   }
   return out;
+}
+
+std::filesystem::path fresh_directory(const std::string& prefix) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / (prefix + "-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
 }
 
 std::string rs274_missing(const std::filesystem::path& source) {

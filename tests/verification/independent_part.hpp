@@ -47,6 +47,9 @@ struct CanonicalProgram {
 // rs274's standard output (scripts/rs274 -g).
 CanonicalProgram read_canonical(const std::string& text);
 
+// An empty directory of its own under the system's temporary one: `prefix`-<pid>.
+std::filesystem::path fresh_directory(const std::string& prefix);
+
 // Empty when scripts/setup has unpacked LinuxCNC's rs274 into the source tree's
 // .peers/linuxcnc; else what is missing and how to get it (a failure, never a skip).
 std::string rs274_missing(const std::filesystem::path& source);
