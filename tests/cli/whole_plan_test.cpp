@@ -4,7 +4,8 @@
 // minute in the everyday build, up to a quarter of an hour under the sanitizers), so they
 // carry the ctest label `whole-plan`, which the sanitizer suite leaves out
 // (docs/hardening.md): the code they run is under the sanitizers in the smaller plans of
-// cli_test.cpp, export_test.cpp, run_test.cpp and tests/validation.
+// cli_test.cpp, export_test.cpp, run_test.cpp and tests/validation, and LinuxCNC's rs274
+// reads exported programs there too (ArcExport, Export.TheFlangedHubDepositedThenMilled...).
 
 #include <gtest/gtest.h>
 
@@ -20,6 +21,8 @@ namespace {
 namespace fs = std::filesystem;
 
 using hybridctl::cli_testing::Outcome;
+using hybridctl::cli_testing::quote;
+using hybridctl::cli_testing::run_shell;
 using hybridctl::cli_testing::slurp;
 
 class WholePlan : public hybridctl::cli_testing::DirectoryTest {
@@ -190,6 +193,39 @@ TEST_F(WholePlan, AWornHubIsRepairedByDepositingOnlyWhatItLacksAndEveryPlanRunsW
   for (auto it = std::sregex_iterator(r.out.begin(), r.out.end(), deposit); it != std::sregex_iterator(); ++it, ++deposits)
     EXPECT_LT(std::stod((*it)[1]), 2454 * 1.2) << it->str();
   EXPECT_GE(deposits, 5);
+}
+
+// hybridctl export as a user runs it, on the bundled example parts that have valid plans on
+// the LinuxCNC machine: every program of their two best plans is exported, and LinuxCNC's
+// own interpreter (rs274, the real peer unpacked by scripts/setup) and `hybridctl gcode
+// check` accept it.
+TEST_F(WholePlan, EveryProgramForTheExamplePartsPassesRs274AndOurCheck) {
+  ASSERT_TRUE(fs::exists(fs::path(HYBRIDCTL_SOURCE_DIR) / ".peers/linuxcnc/usr/bin/rs274"))
+      << "LinuxCNC's rs274 is missing: run scripts/setup (it unpacks linuxcnc-uspace into .peers/linuxcnc)";
+  const std::string machine = kMachine;
+  const fs::path rs274 = fs::path(HYBRIDCTL_SOURCE_DIR) / "scripts/rs274";
+  for (const std::string part : {"flanged-hub", "fins", "overhang"}) {
+    const fs::path plan = dir_ / part / "plan";
+    const Outcome planned =
+        run({"plan", kParts + part + ".stl", "--machine", machine, "--voxel", "0.5", "--top", "2", "-o", plan.string()});
+    ASSERT_EQ(planned.exit_code, 0) << part << "\n" << planned.out << planned.err;
+    int programs = 0;
+    for (int rank = 1; rank <= 2; ++rank) {
+      const fs::path out = dir_ / part / ("plan-" + std::to_string(rank));
+      const Outcome exported = run({"export", plan.string(), "--plan", std::to_string(rank), "-o", out.string()});
+      ASSERT_EQ(exported.exit_code, 0) << part << " plan " << rank << "\n" << exported.out << exported.err;
+      for (const auto& entry : fs::directory_iterator(out)) {
+        if (entry.path().extension() != ".ngc") continue;
+        ++programs;
+        const Outcome linuxcnc =
+            run_shell(quote(rs274.string()) + " -t " + quote((out / "tool.tbl").string()) + " -g " + quote(entry.path().string()), dir_);
+        EXPECT_EQ(linuxcnc.exit_code, 0) << entry.path() << "\n" << linuxcnc.err.substr(0, 2000);
+        const Outcome ours = run({"gcode", "check", entry.path().string(), "--machine", machine});
+        EXPECT_EQ(ours.exit_code, 0) << entry.path() << "\n" << ours.out.substr(0, 2000) << ours.err;
+      }
+    }
+    EXPECT_GE(programs, 2 * 2) << part << ": a whole program and at least one action program per plan";
+  }
 }
 
 }  // namespace
