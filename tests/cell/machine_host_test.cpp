@@ -100,7 +100,7 @@ class MachineHost : public CellTest {
 TEST_F(MachineHost, AHostKilledMidProgramIsResumedByAnotherAndEveryLineRunsOnce) {
   const std::int64_t job = planned_job();
   auto sim = controller("20");
-  auto first = std::make_unique<Process>(host_command("--name first --lease 6 --yes --drain"), dir_ / "first.out");
+  auto first = std::make_unique<Process>(host_command("--name first --lease 15 --yes --drain"), dir_ / "first.out");
   ASSERT_TRUE(executed_past(job, 20)) << slurp(dir_ / "first.out");
   kill(first->pid, SIGKILL);
   first->wait(10);
@@ -116,9 +116,11 @@ TEST_F(MachineHost, AHostKilledMidProgramIsResumedByAnotherAndEveryLineRunsOnce)
   EXPECT_EQ(other.wait(60), 0) << slurp(dir_ / "other.out");
   EXPECT_EQ(value("SELECT state || ' ' || machine FROM cell_jobs WHERE id = " + std::to_string(job)), "streaming mill");
 
-  // The first host's short lease (6 s) makes the wait for it short; the second's is the others'
-  // 20 s: it stops streaming when its journal has not been written for half its lease, and
-  // on a loaded machine (two cores, the cell's four planning workers beside it) 1.5 s went by.
+  // The first host's lease (15 s) still holds the machine when the second starts, after
+  // the other machine's host has come and gone (3 s was over by then under the
+  // sanitizers), and the second waits it out. The second's is the others' 20 s: a host
+  // stops streaming when its journal has not been written for half its lease, and on a
+  // loaded machine (two cores, the cell's four planning workers beside it) 1.5 s went by.
   Process second(host_command("--name second --lease 20 --yes --drain"), dir_ / "second.out");
   EXPECT_EQ(second.wait(600), 0) << slurp(dir_ / "second.out");
   const std::string said = slurp(dir_ / "second.out");
