@@ -202,12 +202,11 @@ TEST_F(WholePlan, AWornHubIsRepairedByDepositingOnlyWhatItLacksAndEveryPlanRunsW
 TEST_F(WholePlan, EveryProgramForTheExamplePartsPassesRs274AndOurCheck) {
   ASSERT_TRUE(fs::exists(fs::path(HYBRIDCTL_SOURCE_DIR) / ".peers/linuxcnc/usr/bin/rs274"))
       << "LinuxCNC's rs274 is missing: run scripts/setup (it unpacks linuxcnc-uspace into .peers/linuxcnc)";
-  const std::string machine = kMachine;
   const fs::path rs274 = fs::path(HYBRIDCTL_SOURCE_DIR) / "scripts/rs274";
   for (const std::string part : {"flanged-hub", "fins", "overhang"}) {
     const fs::path plan = dir_ / part / "plan";
     const Outcome planned =
-        run({"plan", kParts + part + ".stl", "--machine", machine, "--voxel", "0.5", "--top", "2", "-o", plan.string()});
+        run({"plan", kParts + part + ".stl", "--machine", kMachine, "--voxel", "0.5", "--top", "2", "-o", plan.string()});
     ASSERT_EQ(planned.exit_code, 0) << part << "\n" << planned.out << planned.err;
     int programs = 0;
     for (int rank = 1; rank <= 2; ++rank) {
@@ -220,7 +219,7 @@ TEST_F(WholePlan, EveryProgramForTheExamplePartsPassesRs274AndOurCheck) {
         const Outcome linuxcnc =
             run_shell(quote(rs274.string()) + " -t " + quote((out / "tool.tbl").string()) + " -g " + quote(entry.path().string()), dir_);
         EXPECT_EQ(linuxcnc.exit_code, 0) << entry.path() << "\n" << linuxcnc.err.substr(0, 2000);
-        const Outcome ours = run({"gcode", "check", entry.path().string(), "--machine", machine});
+        const Outcome ours = run({"gcode", "check", entry.path().string(), "--machine", kMachine});
         EXPECT_EQ(ours.exit_code, 0) << entry.path() << "\n" << ours.out.substr(0, 2000) << ours.err;
       }
     }
