@@ -18,8 +18,11 @@
 //                  from M's (a missing fin: its tip from the plate left; a filled slot:
 //                  its floor from the surface over it).
 //
-// Both at most t is `within_tolerance`. The half-voxel convention: one layer of voxels
-// too many or too few is one voxel (h) off both ways. The older fields `worst_over` and
+// Both at most t is `within_tolerance`. The half-voxel convention makes one layer too many
+// or too few one voxel (h) off both ways; a layer's voxel round an edge or a corner, meeting
+// the other side at an edge or a corner only, is sqrt(2) or sqrt(3) h off, and where t >= h
+// (always, within the planning band) it is within t too: it is the same one layer the
+// grid resolves, and the real surface is exact verification's to judge. The older fields `worst_over` and
 // `worst_under` keep their meaning, the depth of the wrong voxel's centre, h/2 less.
 
 #include <cstddef>
@@ -69,6 +72,10 @@ struct ExactDeviation {
 // One line for people: "excess 0.24 mm at (x, y, z) by action 2 (line 812), gouge 0.12 mm
 // at ... ; 97.1 % of the surface within 0.5 mm: within tolerance".
 std::string exact_deviation_text(const ExactDeviation& d);
+
+// How far (mm) worst_out and worst_missing may go and still be within `tolerance` on a grid
+// of `voxel` mm: where one layer is within it, one layer in any direction is (above).
+double judged_limit(double tolerance, double voxel);
 
 // `made` and `design` on one lattice. Everything outside `made` is air, also beyond
 // `domain` (kept for callers; the distances do not depend on it).

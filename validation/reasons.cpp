@@ -68,20 +68,21 @@ void add_incidents(const Execution& run, const config::Machine& machine, std::ve
 }
 
 // The part as built against the design, both ways, with the tolerance.
-void add_deviation(const Execution& run, double tolerance, std::vector<RejectionReason>& out) {
+void add_deviation(const Execution& run, double tolerance, double voxel, std::vector<RejectionReason>& out) {
   const plan::Deviation& d = run.deviation;
   if (d.within_tolerance) return;
+  const double limit = plan::judged_limit(tolerance, voxel);
   // The two-sided test that decides `within_tolerance` (plan/deviation.hpp) names the
   // reasons: a fin left out leaves few voxels empty, none deep, yet the design's surface at
   // its tip is far from the part made.
-  if (d.worst_missing > tolerance)
+  if (d.worst_missing > limit)
     out.push_back({"missing_material", 0, 0,
                    "as built, " + fixed_number(d.under_volume, 1) +
                        " mm^3 of the design is missing; the design's surface lies up to " +
                        fixed_number(d.worst_missing, 2) + " mm from the part made; tolerance " +
                        trimmed_number(tolerance, 3) + " mm",
                    d.worst_missing_at});
-  if (d.worst_out > tolerance)
+  if (d.worst_out > limit)
     out.push_back({"excess_material", 0, 0,
                    "as built, " + fixed_number(d.over_volume, 1) +
                        " mm^3 of material lies outside the design; the part's surface (or a hole the design does not "
@@ -137,7 +138,7 @@ std::vector<RejectionReason> rejection_reasons(const Execution& run, const plan:
   add_path_defects(run, machine, out);
   add_incidents(run, machine, out);
   for (const std::string& e : run.errors) out.push_back({"refused_line", 0, 0, e, std::nullopt});
-  if (run.stopped_after == 0) add_deviation(run, file.band(), out);  // stopped early: not measured
+  if (run.stopped_after == 0) add_deviation(run, file.band(), file.lattice.voxel_size, out);  // stopped early: not measured
   return out;
 }
 

@@ -109,8 +109,24 @@ TEST(Deviation, AShavedCubesCornersAreFartherThanItsFaces) {
   EXPECT_DOUBLE_EQ(d.worst_missing_at->x, 4.5);  // the first corner voxel in z, y, x order
   EXPECT_DOUBLE_EQ(d.worst_missing_at->y, 4.5);
   EXPECT_DOUBLE_EQ(d.worst_missing_at->z, 4.5);
-  EXPECT_FALSE(d.within_tolerance);
-  EXPECT_TRUE(measure_deviation(made, design, kDomain, std::sqrt(3.0)).within_tolerance);
+  // Still one layer, whatever the direction: within a tolerance of one voxel.
+  EXPECT_TRUE(d.within_tolerance);
+  EXPECT_FALSE(measure_deviation(made, design, kDomain, 0.9).within_tolerance);
+}
+
+// Where a tolerance of a voxel holds one layer too many along an axis, it holds that layer
+// round an edge too: the voxel beside the design's edge touches the design at an edge only,
+// its centre sqrt(2) voxels from the design's, and is the same one layer the grid
+// resolves. A second layer is beyond it.
+TEST(Deviation, OneLayerRoundAnEdgeIsOneLayerToo) {
+  const Solid design = box({4, 4, 2}, {10, 10, 8});
+  const Solid one_layer = box({4, 4, 2}, {11, 11, 8});
+  const Deviation d = measure_deviation(one_layer, design, kDomain, 1.0);
+  EXPECT_DOUBLE_EQ(d.worst_out, std::sqrt(2.0));  // the column of voxels at (10, 10)
+  EXPECT_TRUE(d.within_tolerance);
+  const Solid two_layers = box({4, 4, 2}, {12, 12, 8});
+  EXPECT_FALSE(measure_deviation(two_layers, design, kDomain, 1.0).within_tolerance);
+  EXPECT_GT(measure_deviation(two_layers, design, kDomain, 1.0).worst_out, std::sqrt(3.0));
 }
 
 // A hollow box with walls 1 thick, made solid. The surfaces alone are only the wall's
