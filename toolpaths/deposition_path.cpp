@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -14,6 +15,7 @@
 #include "toolpaths/contour_reach.hpp"
 #include "toolpaths/setup_frame.hpp"
 #include "toolpaths/slices.hpp"
+#include "toolpaths/wall_finish.hpp"
 
 namespace hybridctl::toolpaths {
 namespace {
@@ -224,7 +226,12 @@ class DepositionBuilder {
   SliceMask layer_region(const Solid& solid, double zb, int& k) const;
   void drop_blocked(SliceMask& region, int k, int layer, double zb);
   void drop_overhangs(SliceMask& region, int layer, double zb);
-  std::vector<Pass> passes_of(const SliceMask& region, const SliceMask& wall, int layer, double angle, double zb);
+  std::vector<Pass> passes_of(const SliceMask& region, const SliceMask& wall, int layer, double angle, double zb,
+                              const TipKeepOut* within);
+  // DepositionOptions::near_net_design: where the layer's bead axes may go, and the passes
+  // kept there.
+  std::optional<TipKeepOut> near_net_region(double zb) const;
+  void keep_within(const TipKeepOut& inside, std::vector<Pass>& contour, std::vector<Pass>& rasters) const;
   // How far sideways a pass lays material at every voxel centre of the band at zb.
   double cover_of(double zb) const;
   void finish();
@@ -513,7 +520,7 @@ double DepositionBuilder::cover_of(double zb) const {
 }
 
 std::vector<Pass> DepositionBuilder::passes_of(const SliceMask& region, const SliceMask& wall, int layer, double angle,
-                                               double zb) {
+                                               double zb, const TipKeepOut* within) {
   const bool reverse_start = (layer / int(angles_.size())) % 2 == 1;
   std::vector<Pass> contour;
   RasterResult infill;
@@ -530,11 +537,46 @@ std::vector<Pass> DepositionBuilder::passes_of(const SliceMask& region, const Sl
     infill = raster_layer(region, lattice_, angle, s_, min_length_, inset_, reverse_start, &wall);
   }
   dropped_total_ += infill.dropped;
+  if (within) keep_within(*within, contour, infill.passes);
   std::vector<Pass> passes;
   if (options_.contour == ContourPass::BeforeInfill) passes = contour;
   passes.insert(passes.end(), infill.passes.begin(), infill.passes.end());
   if (options_.contour == ContourPass::AfterInfill) passes.insert(passes.end(), contour.begin(), contour.end());
   return passes;
+}
+
+// Where a near-net layer's bead axes may go: within the design's sections from the band's
+// bottom to its top, shrunk by half a bead; none without a design or where no axis fits.
+std::optional<TipKeepOut> DepositionBuilder::near_net_region(double zb) const {
+  if (!options_.near_net_design) return std::nullopt;
+  constexpr double kInside = 1e-6;  // mm off the band's faces, where a flat face of the design may lie
+  TipKeepOut inside = section_shrunk(*options_.near_net_design, {zb + kInside, zb + lh_ - kInside},
+                                     w_ / 2 - std::max(0.0, options_.near_net_slack));
+  if (inside.empty()) return std::nullopt;
+  return inside;
+}
+
+void DepositionBuilder::keep_within(const TipKeepOut& inside, std::vector<Pass>& contour, std::vector<Pass>& rasters) const {
+  for (Pass& p : contour)
+    for (Vec2& q : p.points) {
+      if (inside.contains(q)) continue;
+      const Vec2 edge = inside.nearest_on_boundary(q);
+      if (std::hypot(edge.x - q.x, edge.y - q.y) <= h_) q = edge;
+    }
+  for (Pass& p : contour)  // points moved onto one another
+    p.points.erase(std::unique(p.points.begin(), p.points.end(),
+                               [](Vec2 a, Vec2 b) { return std::hypot(a.x - b.x, a.y - b.y) < 1e-9; }),
+                   p.points.end());
+  std::vector<Pass> kept;
+  for (const Pass& p : rasters) {
+    // A raster kept whole stays, however short its inset left it; a piece cut off by the
+    // wall is as long as a bead at least.
+    const Vec2 a0 = p.points.front(), b0 = p.points.back();
+    const double whole = std::hypot(b0.x - a0.x, b0.y - a0.y);
+    for (const auto& [a, b] : inside.pieces_inside(a0, b0))
+      if (std::hypot(b.x - a.x, b.y - a.y) >= std::min(whole, min_length_) - 1e-9) kept.push_back({{a, b}});
+  }
+  rasters = std::move(kept);
 }
 
 void DepositionBuilder::deposit_layer(int layer, double zb) {
@@ -560,7 +602,8 @@ void DepositionBuilder::deposit_layer(int layer, double zb) {
   const bool check_body = counted_ && head_.nozzle;
   int counted_top = 0;
   const SliceMask counted_here = check_body ? layer_region(*counted_, zb, counted_top) : empty_mask_;
-  for (const Pass& p : passes_of(region, wall, layer, angle, zb)) {
+  const std::optional<TipKeepOut> within = near_net_region(zb);
+  for (const Pass& p : passes_of(region, wall, layer, angle, zb, within ? &*within : nullptr)) {
     if (check_body && !touches(p, counted_here) && body_meets_material(p, zb)) {
       ++body_skipped_;
       continue;
@@ -573,10 +616,19 @@ void DepositionBuilder::deposit_layer(int layer, double zb) {
       move(MoveKind::Feed, {p.points[i].x, p.points[i].y, zb}, head_.feed, true, std::move(comment));
     }
   }
-  // The layer is down: layer_height of material on its region.
+  // The layer is down: layer_height of material on its region, as far as its beads reach
+  // (a near-net layer's stop on the design's walls: the next layer is supported by what
+  // they laid, as the simulator holds it, not by the voxels past them).
+  const auto laid = [&](int x, int y) {
+    if (!within) return true;
+    const Vec2 c{lattice_.origin.x + (x + 0.5) * h_, lattice_.origin.y + (y + 0.5) * h_};
+    if (within->contains(c)) return true;
+    const Vec2 e = within->nearest_on_boundary(c);
+    return std::hypot(e.x - c.x, e.y - c.y) <= w_ / 2;
+  };
   for (int y = window_.lo.y; y < window_.hi.y; ++y)
     for (int x = window_.lo.x; x < window_.hi.x; ++x)
-      if (region.at(x, y)) deposited_top_.ref(x, y) = std::max(deposited_top_.at(x, y), zb + lh_);
+      if (region.at(x, y) && laid(x, y)) deposited_top_.ref(x, y) = std::max(deposited_top_.at(x, y), zb + lh_);
 }
 
 // Up and clear of the part, and the summaries of the warnings.

@@ -19,11 +19,13 @@
 // The programmed point is the bottom of the bead on its axis: the surface the bead is
 // laid on (z = the layer's bottom).
 
+#include <memory>
 #include <optional>
 #include <vector>
 
 #include "config/machine.hpp"
 #include "toolpaths/toolpath.hpp"
+#include "geometry/mesh.hpp"
 #include "geometry/solid.hpp"
 
 namespace hybridctl::toolpaths {
@@ -78,6 +80,20 @@ struct DepositionOptions {
   // then lacks is judged where the part is judged (validation compares it with the
   // design). Null: all of the ROI is counted on.
   const geometry::Solid* counted_on = nullptr;
+  // A near-net deposit's design (work frame; its surface, closed: the STL's facets turned
+  // into the setup's frame): each layer's passes are kept where the bead's axis lies within
+  // the design's exact cross-section at the layer's middle shrunk by half a bead, so that
+  // its beads end on the design's real walls, not half a voxel past them where a wall runs
+  // through voxel centres. A contour point out of that region (grown by near_net_slack)
+  // by at most a voxel goes to its edge, a raster is cut at it; a layer whose section holds no such place keeps
+  // its voxel passes. Null: passes on the voxels alone (an overfill deposit's, whose beads
+  // stand out of the design on purpose).
+  std::shared_ptr<const std::vector<geometry::Triangle>> near_net_design;
+  // How far (mm) a near-net bead may stand past the design's wall before it is pulled in:
+  // plan export gives half of what the part's tolerance leaves beyond the head's
+  // as-deposited accuracy, so that passes move no more than they must (a pass pulled in
+  // comes apart from the rasters beside it a little).
+  double near_net_slack = 0;
 };
 
 // The deposition toolpath of one additive action.

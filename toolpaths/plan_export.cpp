@@ -100,6 +100,11 @@ void make_program(const plan::PlanFile& file, const geometry::IndexBox& simulate
     d.fallback_tool_number = instruments::head_tool_number(machine, index);
     if (!d.build_plate_z && !a.before.empty()) d.build_plate_z = plate_z(file, simulated, setup);
     d.counted_on = counted_on;
+    // A near-net deposit's beads end on the design's real walls.
+    if (design && p.kind == config::PrimitiveKind::UAm) {
+      d.near_net_design = design->in(setup.approach);
+      d.near_net_slack = std::max(0.0, file.tolerance - head->accuracy) / 2;
+    }
     prog.path = deposition_path(a.roi, a.before, *head, setup, d);
   } else {
     const config::CuttingTool* tool = machine.find_tool(p.tool_number);

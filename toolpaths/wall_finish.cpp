@@ -188,12 +188,11 @@ bool TipKeepOut::contains(Point2 p) const {
   return inside;
 }
 
-bool TipKeepOut::segment_clear(Point2 a, Point2 b) const {
+std::vector<double> TipKeepOut::meeting_parameters(Point2 a, Point2 b) const {
   const Point2 d = minus(b, a);
   const double len = std::hypot(d.x, d.y);
-  if (len == 0) return !contains(a) || loops_.empty();
-  // Where the segment meets the loops, as parameters along it.
   std::vector<double> ts{0.0, 1.0};
+  if (len == 0) return ts;
   constexpr double kParallel = 1e-12;
   for (const auto& loop : loops_)
     for (std::size_t i = 0, n = loop.size(); i < n; ++i) {
@@ -215,14 +214,56 @@ bool TipKeepOut::segment_clear(Point2 a, Point2 b) const {
       if (t >= -tslack && t <= 1 + tslack && u >= -uslack && u <= 1 + uslack) ts.push_back(std::clamp(t, 0.0, 1.0));
     }
   std::sort(ts.begin(), ts.end());
+  return ts;
+}
+
+bool TipKeepOut::segment_clear(Point2 a, Point2 b) const {
+  const Point2 d = minus(b, a);
+  if (std::hypot(d.x, d.y) == 0) return !contains(a) || loops_.empty();
   // Each piece between two meeting points lies wholly inside or wholly outside: test its
   // middle, which is off the boundary unless the piece runs along it (then refused).
+  const std::vector<double> ts = meeting_parameters(a, b);
   for (std::size_t i = 0; i + 1 < ts.size(); ++i) {
     if (ts[i + 1] - ts[i] <= 1e-12) continue;
     const double t = (ts[i] + ts[i + 1]) / 2;
     if (contains({a.x + t * d.x, a.y + t * d.y})) return false;
   }
   return true;
+}
+
+std::vector<std::pair<Point2, Point2>> TipKeepOut::pieces_inside(Point2 a, Point2 b) const {
+  std::vector<std::pair<Point2, Point2>> out;
+  const Point2 d = minus(b, a);
+  const auto at = [&](double t) { return Point2{a.x + t * d.x, a.y + t * d.y}; };
+  if (std::hypot(d.x, d.y) == 0) {
+    if (contains(a)) out.push_back({a, b});
+    return out;
+  }
+  const std::vector<double> ts = meeting_parameters(a, b);
+  for (std::size_t i = 0; i + 1 < ts.size(); ++i) {
+    if (ts[i + 1] - ts[i] <= 1e-12 || !contains(at((ts[i] + ts[i + 1]) / 2))) continue;
+    if (!out.empty() && std::hypot(out.back().second.x - at(ts[i]).x, out.back().second.y - at(ts[i]).y) <= 1e-12)
+      out.back().second = at(ts[i + 1]);  // pieces on either side of a touching point join
+    else
+      out.push_back({at(ts[i]), at(ts[i + 1])});
+  }
+  return out;
+}
+
+Point2 TipKeepOut::nearest_on_boundary(Point2 p) const {
+  Point2 best = p;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (const auto& loop : loops_)
+    for (std::size_t i = 0, n = loop.size(); i < n; ++i) {
+      const Point2 a = loop[i], b = loop[(i + 1) % n];
+      const Point2 e = minus(b, a), w = minus(p, a);
+      const double len2 = e.x * e.x + e.y * e.y;
+      const double t = len2 > 0 ? std::clamp((w.x * e.x + w.y * e.y) / len2, 0.0, 1.0) : 0.0;
+      const Point2 q{a.x + t * e.x, a.y + t * e.y};
+      const double dist = std::hypot(p.x - q.x, p.y - q.y);
+      if (dist < best_d) best_d = dist, best = q;
+    }
+  return best;
 }
 
 TipKeepOut TipKeepOut::grown(double by, double chord_tolerance) const {
@@ -252,6 +293,20 @@ TipKeepOut tip_keep_out(const std::vector<Triangle>& design, double tip_z, const
     all.insert(all.end(), grown.begin(), grown.end());
   }
   return TipKeepOut(to_loops(union_of(all, ClipperLib::pftNonZero)));
+}
+
+TipKeepOut section_shrunk(const std::vector<Triangle>& design, const std::vector<double>& heights, double inset,
+                          double chord_tolerance) {
+  Paths sections;
+  for (const double z : heights) {
+    const Paths s = cross_section(design, z);
+    sections.insert(sections.end(), s.begin(), s.end());
+  }
+  const Paths section = union_of(sections, ClipperLib::pftNonZero);
+  if (section.empty()) return {};
+  // Clipper gives outer loops counter-clockwise: the region on the left, as the
+  // constructor takes it.
+  return TipKeepOut(to_loops(offset(section, -inset, chord_tolerance)));
 }
 
 std::vector<ToolBand> flat_tool_bands(const config::CuttingTool& tool_in) {

@@ -29,6 +29,7 @@
 // covers G-code's 0.0001 mm and the integer rounding) and by at most about
 // chord_tolerance + clearance where that band is the one that limits it.
 
+#include <utility>
 #include <vector>
 
 #include "config/machine.hpp"
@@ -73,8 +74,15 @@ class TipKeepOut {
   bool segment_clear(Point2 a, Point2 b) const;
   // The region grown by `by` mm (round joins; chords at least `by` from it).
   TipKeepOut grown(double by, double chord_tolerance = 0.001) const;
+  // The pieces of the segment a-b that lie in the region (its boundary included), in
+  // order from a; none where it runs outside only.
+  std::vector<std::pair<Point2, Point2>> pieces_inside(Point2 a, Point2 b) const;
+  // The point of the boundary nearest p; p itself when there is no boundary.
+  Point2 nearest_on_boundary(Point2 p) const;
 
  private:
+  // Where the segment a-b meets the loops, as parameters along it, sorted, 0 and 1 included.
+  std::vector<double> meeting_parameters(Point2 a, Point2 b) const;
   std::vector<std::vector<Point2>> loops_;  // region on the right
 };
 
@@ -82,6 +90,13 @@ class TipKeepOut {
 // bounded by `design` (closed; duplicate facets removed: geometry::clean_mesh).
 TipKeepOut tip_keep_out(const std::vector<geometry::Triangle>& design, double tip_z, const std::vector<ToolBand>& bands,
                         const WallFinishOptions& options = {});
+
+// The union of the design's cross-sections at `heights`, shrunk by `inset` mm (round
+// joins): where the axis of a bead `inset` wide on either side keeps its whole width inside
+// the design at one of those heights (a near-net deposit's layer, from its bottom to its
+// top). Not a keep-out: the region is where the axis may go.
+TipKeepOut section_shrunk(const std::vector<geometry::Triangle>& design, const std::vector<double>& heights,
+                          double inset, double chord_tolerance = 0.001);
 
 // A flat end mill's bands (its defaults applied: instruments::with_defaults): the cutter
 // over [0, flute], the shank over [flute, flute + shank length], the holder above; each as

@@ -16,6 +16,7 @@
 #include "toolpaths/setup_frame.hpp"
 #include "geometry/shapes.hpp"
 #include "toolpath_oracles.hpp"
+#include "../geometry/mesh_fixtures.hpp"
 
 namespace hybridctl::toolpaths {
 namespace {
@@ -99,6 +100,13 @@ void expect_segments_in_region(const Toolpath& p, const Solid& roi, double layer
   EXPECT_EQ(outside, 0);
 }
 
+// How many heights the deposition moves lie at.
+std::size_t layer_count(const Toolpath& p) {
+  std::set<double> heights;
+  for (const Segment& s : deposition_segments(p)) heights.insert(s.a.z);
+  return heights.size();
+}
+
 bool has_warning(const Toolpath& p, const std::string& word) {
   for (const auto& w : p.warnings)
     if (w.find(word) != std::string::npos) return true;
@@ -160,6 +168,37 @@ TEST(DepositionPath, ContourPassesStayInTheRegionToo) {
     directions.insert({int(std::round(segs[i].b.x - segs[i].a.x > 0 ? 1 : segs[i].b.x < segs[i].a.x ? -1 : 0)),
                        int(std::round(segs[i].b.y - segs[i].a.y > 0 ? 1 : segs[i].b.y < segs[i].a.y ? -1 : 0))});
   EXPECT_GE(directions.size(), 3u);
+}
+
+// A wall whose faces run through voxel centres (y = 2.25 and 4.75 on 0.5 mm voxels): the
+// voxel region holds the centres on the faces, and on the voxels alone the contour is
+// pulled out to cover them, its bead past the faces. Given the design, a near-net
+// deposit's beads end on its real faces: every bead's axis at least half a bead inside.
+TEST(DepositionPath, ANearNetDepositsBeadsEndOnTheDesignsRealWalls) {
+  const geometry::TriangleMesh wall = geometry::testing::box_mesh({2.25, 2.25, 0}, {14.75, 4.75, 1.8});
+  const Solid roi = make_box(kLattice, {{2, 2, 0}, {15, 5, 1.8}});  // the voxels whose centres lie in the wall
+  const auto head = ded_head();
+  const double half_bead = head.bead.width / 2;
+  const auto worst_past_a_face = [&](const Toolpath& p) {
+    double worst = -1e9;
+    for (const Segment& s : deposition_segments(p))
+      along(s.a, s.b, 0.05, [&](Vec3 q) {
+        worst = std::max({worst, 2.25 - (q.y - half_bead), (q.y + half_bead) - 4.75, 2.25 - (q.x - half_bead),
+                          (q.x + half_bead) - 14.75});
+      });
+    return worst;
+  };
+  DepositionOptions on_voxels;
+  const Toolpath voxels = deposition_path(roi, Solid(kLattice, {}), head, top_setup(), on_voxels);
+  EXPECT_GT(worst_past_a_face(voxels), 0.05) << "on the voxels the bead stands past the faces";
+  DepositionOptions near_net;
+  near_net.near_net_design = std::make_shared<const std::vector<geometry::Triangle>>(wall.triangles);
+  const Toolpath exact = deposition_path(roi, Solid(kLattice, {}), head, top_setup(), near_net);
+  EXPECT_LE(worst_past_a_face(exact), 0.002);
+  // It still lays the wall: every layer, with its contour and rasters.
+  EXPECT_EQ(layer_count(exact), layer_count(voxels));
+  EXPECT_GE(deposition_segments(exact).size(), deposition_segments(voxels).size() / 2);
+  expect_segments_in_region(exact, roi, head.layer_height);
 }
 
 TEST(DepositionPath, LayersGoBottomUpAtTheLayerHeight) {

@@ -381,5 +381,30 @@ TEST(WallFinish, OnlyFlatToolsHaveBands) {
   EXPECT_TRUE(flat_tool_bands(t).empty());
 }
 
+// A near-net deposit's layer: the section of a frame (a block with a pocket) shrunk by half
+// a bead is where the bead's axis may go; a line across it is cut into the pieces that lie
+// there, and a point off it goes to its nearest edge.
+TEST(WallFinish, ASectionShrunkByHalfABeadHoldsTheBeadsAxisAndCutsLinesAtItsEdges) {
+  const Mesh block = frame(rectangle(0, 0, 20, 10), rectangle(8, 2, 12, 8), 0, 5);
+  const TipKeepOut axis = section_shrunk(block, {2.0, 2.5}, 0.75);
+  EXPECT_TRUE(axis.contains({0.76, 5}));
+  EXPECT_FALSE(axis.contains({0.74, 5}));
+  EXPECT_FALSE(axis.contains({10, 5})) << "the pocket, grown by half a bead, holds no axis";
+  EXPECT_TRUE(axis.contains({7.24, 5}));
+  // Across the block through the pocket: two pieces, each ending half a bead from a wall.
+  const auto pieces = axis.pieces_inside({-3, 5}, {23, 5});
+  ASSERT_EQ(pieces.size(), 2u);
+  EXPECT_NEAR(pieces[0].first.x, 0.75, 1e-3);
+  EXPECT_NEAR(pieces[0].second.x, 7.25, 1e-3);
+  EXPECT_NEAR(pieces[1].first.x, 12.75, 1e-3);
+  EXPECT_NEAR(pieces[1].second.x, 19.25, 1e-3);
+  EXPECT_TRUE(axis.pieces_inside({9, 5}, {11, 5}).empty());
+  const Point2 edge = axis.nearest_on_boundary({0.5, 5});
+  EXPECT_NEAR(edge.x, 0.75, 1e-3);
+  EXPECT_NEAR(edge.y, 5, 1e-9);
+  // Above the block there is no section: no place for an axis.
+  EXPECT_TRUE(section_shrunk(block, {6.0}, 0.75).empty());
+}
+
 }  // namespace
 }  // namespace hybridctl::toolpaths
