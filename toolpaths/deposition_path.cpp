@@ -335,6 +335,10 @@ void DepositionBuilder::start_columns(const Solid& existing, const IndexBox& roi
   empty_mask_ = SliceMask(window_.lo.x, window_.lo.y, window_.hi.x - window_.lo.x, window_.hi.y - window_.lo.y);
 
   z0_ = face(roi_box.lo.z), z_top_ = face(roi_box.hi.z);
+  // A near-net deposit's layers end on its top: as many as the head's layer height needs,
+  // a little thinner each, so the last bead's top stands over the top face by the beads'
+  // overlap, not by most of a layer more.
+  if (options_.near_net_design && z_top_ > z0_) lh_ = (z_top_ - z0_) / std::ceil((z_top_ - z0_) / lh_ - 1e-9);
   safe_z_ = std::max({highest_existing, z_top_, z0_ + std::ceil((z_top_ - z0_) / lh_) * lh_}) +
             std::max(head_.bead.height, 0.0) + travel_;
   path_.safe_z = safe_z_;

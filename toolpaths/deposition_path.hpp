@@ -86,7 +86,8 @@ struct DepositionOptions {
   // its beads end on the design's real walls, not half a voxel past them where a wall runs
   // through voxel centres. A contour point out of that region (grown by near_net_slack)
   // by at most a voxel goes to its edge, a raster is cut at it; a layer whose section holds no such place keeps
-  // its voxel passes. Null: passes on the voxels alone (an overfill deposit's, whose beads
+  // its voxel passes. Its layers are a little thinner than the head's layer height where
+  // that makes the last one end on the deposit's top. Null: passes on the voxels alone (an overfill deposit's, whose beads
   // stand out of the design on purpose).
   std::shared_ptr<const std::vector<geometry::Triangle>> near_net_design;
   // How far (mm) a near-net bead may stand past the design's wall before it is pulled in:
