@@ -550,7 +550,8 @@ std::vector<Pass> DepositionBuilder::passes_of(const SliceMask& region, const Sl
 }
 
 // Where a near-net layer's bead axes may go: within the design's sections from the band's
-// bottom to its top, shrunk by half a bead; none without a design or where no axis fits.
+// bottom to its top, shrunk by half a bead less the slack; none without a design or where
+// no axis fits.
 std::optional<TipKeepOut> DepositionBuilder::near_net_region(double zb) const {
   if (!options_.near_net_design) return std::nullopt;
   constexpr double kInside = 1e-6;  // mm off the band's faces, where a flat face of the design may lie
@@ -621,8 +622,8 @@ void DepositionBuilder::deposit_layer(int layer, double zb) {
     }
   }
   // The layer is down: layer_height of material on its region, as far as its beads reach
-  // (a near-net layer's stop on the design's walls: the next layer is supported by what
-  // they laid, as the simulator holds it, not by the voxels past them).
+  // (a near-net layer's beads stop on the design's walls: the next layer is supported by
+  // what they laid, as the simulator holds it, not by the voxels past them).
   const auto laid = [&](int x, int y) {
     if (!within) return true;
     const Vec2 c{lattice_.origin.x + (x + 0.5) * h_, lattice_.origin.y + (y + 0.5) * h_};
