@@ -100,7 +100,6 @@ std::vector<Shortfall> find_skipped_layer_shortfalls(const PlanningProblem& prob
                                                      const std::vector<plan::RejectionReason>& reasons) {
   const std::size_t executed = std::min(steps, plan.steps.size());
   if (executed < 2) return {};  // never the first action (find_shortfalls)
-  const int n = atoms.atom_count();
   const auto [state, last, changed] = replay_plan(problem, plan, executed);
   const int step = int(executed) - 1;
   const int primitive = plan.steps[std::size_t(step)].primitive;
