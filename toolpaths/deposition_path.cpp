@@ -549,6 +549,30 @@ std::vector<Pass> DepositionBuilder::passes_of(const SliceMask& region, const Sl
   return passes;
 }
 
+// The cells of `window` whose centres lie inside `region` (even-odd over its loops), row by
+// row: where each row's line through the centres crosses the loops.
+SliceMask cells_inside(const TipKeepOut& region, const SliceMask& window, const geometry::Lattice& lattice) {
+  SliceMask out = window;
+  const double h = lattice.voxel_size;
+  std::vector<double> crossings;
+  for (int y = window.y0(); y < window.y0() + window.ny(); ++y) {
+    const double cy = lattice.origin.y + (y + 0.5) * h;
+    crossings.clear();
+    for (const auto& loop : region.loops())
+      for (std::size_t i = 0, n = loop.size(); i < n; ++i) {
+        const Vec2 a = loop[i], b = loop[(i + 1) % n];
+        if ((a.y > cy) != (b.y > cy)) crossings.push_back(a.x + (cy - a.y) / (b.y - a.y) * (b.x - a.x));
+      }
+    std::sort(crossings.begin(), crossings.end());
+    for (std::size_t k = 0; k + 1 < crossings.size(); k += 2) {
+      const int x0 = int(std::ceil((crossings[k] - lattice.origin.x) / h - 0.5)),
+                x1 = int(std::floor((crossings[k + 1] - lattice.origin.x) / h - 0.5));
+      for (int x = std::max(x0, window.x0()); x <= std::min(x1, window.x0() + window.nx() - 1); ++x) out.set(x, y);
+    }
+  }
+  return out;
+}
+
 // Where a near-net layer's bead axes may go: within the design's sections from the band's
 // bottom to its top, shrunk by half a bead less the slack; none without a design or where
 // no axis fits.
@@ -624,16 +648,10 @@ void DepositionBuilder::deposit_layer(int layer, double zb) {
   // The layer is down: layer_height of material on its region, as far as its beads reach
   // (a near-net layer's beads stop on the design's walls: the next layer is supported by
   // what they laid, as the simulator holds it, not by the voxels past them).
-  const auto laid = [&](int x, int y) {
-    if (!within) return true;
-    const Vec2 c{lattice_.origin.x + (x + 0.5) * h_, lattice_.origin.y + (y + 0.5) * h_};
-    if (within->contains(c)) return true;
-    const Vec2 e = within->nearest_on_boundary(c);
-    return std::hypot(e.x - c.x, e.y - c.y) <= w_ / 2;
-  };
+  const SliceMask laid = within ? cells_inside(within->grown(w_ / 2), empty_mask_, lattice_) : region;
   for (int y = window_.lo.y; y < window_.hi.y; ++y)
     for (int x = window_.lo.x; x < window_.hi.x; ++x)
-      if (region.at(x, y) && laid(x, y)) deposited_top_.ref(x, y) = std::max(deposited_top_.at(x, y), zb + lh_);
+      if (region.at(x, y) && laid.at(x, y)) deposited_top_.ref(x, y) = std::max(deposited_top_.at(x, y), zb + lh_);
 }
 
 // Up and clear of the part, and the summaries of the warnings.
