@@ -549,30 +549,6 @@ std::vector<Pass> DepositionBuilder::passes_of(const SliceMask& region, const Sl
   return passes;
 }
 
-// The cells of `window` whose centres lie inside `region` (even-odd over its loops), row by
-// row: where each row's line through the centres crosses the loops.
-SliceMask cells_inside(const TipKeepOut& region, const SliceMask& window, const geometry::Lattice& lattice) {
-  SliceMask out = window;
-  const double h = lattice.voxel_size;
-  std::vector<double> crossings;
-  for (int y = window.y0(); y < window.y0() + window.ny(); ++y) {
-    const double cy = lattice.origin.y + (y + 0.5) * h;
-    crossings.clear();
-    for (const auto& loop : region.loops())
-      for (std::size_t i = 0, n = loop.size(); i < n; ++i) {
-        const Vec2 a = loop[i], b = loop[(i + 1) % n];
-        if ((a.y > cy) != (b.y > cy)) crossings.push_back(a.x + (cy - a.y) / (b.y - a.y) * (b.x - a.x));
-      }
-    std::sort(crossings.begin(), crossings.end());
-    for (std::size_t k = 0; k + 1 < crossings.size(); k += 2) {
-      const int x0 = int(std::ceil((crossings[k] - lattice.origin.x) / h - 0.5)),
-                x1 = int(std::floor((crossings[k + 1] - lattice.origin.x) / h - 0.5));
-      for (int x = std::max(x0, window.x0()); x <= std::min(x1, window.x0() + window.nx() - 1); ++x) out.set(x, y);
-    }
-  }
-  return out;
-}
-
 // Where a near-net layer's bead axes may go: within the design's sections from the band's
 // bottom to its top, shrunk by half a bead less the slack; none without a design or where
 // no axis fits.

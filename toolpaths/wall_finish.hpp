@@ -35,6 +35,7 @@
 #include "config/machine.hpp"
 #include "geometry/mesh.hpp"
 #include "toolpaths/point2.hpp"
+#include "toolpaths/slices.hpp"
 
 namespace hybridctl::toolpaths {
 
@@ -97,6 +98,11 @@ TipKeepOut tip_keep_out(const std::vector<geometry::Triangle>& design, double ti
 // top). Not a keep-out: the region is where the axis may go.
 TipKeepOut section_shrunk(const std::vector<geometry::Triangle>& design, const std::vector<double>& heights,
                           double inset, double chord_tolerance = 0.001);
+
+// The cells of `window` whose centres lie inside `region` (even-odd over its loops), row by
+// row where each row's line through the centres crosses the loops: a near-net layer's
+// cells that its beads reach.
+SliceMask cells_inside(const TipKeepOut& region, const SliceMask& window, const geometry::Lattice& lattice);
 
 // A flat end mill's bands (its defaults applied: instruments::with_defaults): the cutter
 // over [0, flute], the shank over [flute, flute + shank length], the holder above; each as
