@@ -128,25 +128,8 @@ void PocketBuilder::start_finishing(const Solid& region, const Solid* design) {
 TipKeepOut PocketBuilder::keep_out_at(double z) const { return tip_keep_out(*options_.design, z, finish_bands_); }
 
 SliceMask PocketBuilder::cells_in(const TipKeepOut& region) const {
-  SliceMask out(work_.lo.x, work_.lo.y, work_.hi.x - work_.lo.x, work_.hi.y - work_.lo.y);
-  std::vector<double> xs;
-  for (int y = work_.lo.y; y < work_.hi.y; ++y) {
-    const double yc = lattice_.origin.y + (y + 0.5) * h_;
-    xs.clear();
-    for (const auto& loop : region.loops())
-      for (std::size_t i = 0, n = loop.size(); i < n; ++i) {
-        const Point2 a = loop[i], b = loop[(i + 1) % n];
-        if ((a.y > yc) != (b.y > yc)) xs.push_back(a.x + (yc - a.y) / (b.y - a.y) * (b.x - a.x));
-      }
-    std::sort(xs.begin(), xs.end());
-    for (std::size_t i = 0; i + 1 < xs.size(); i += 2) {
-      // Centres in [xs[i], xs[i + 1]], the ends included.
-      const int x0 = int(std::ceil((xs[i] - lattice_.origin.x) / h_ - 0.5 - 1e-9));
-      const int x1 = int(std::floor((xs[i + 1] - lattice_.origin.x) / h_ - 0.5 + 1e-9));
-      for (int x = std::max(x0, work_.lo.x); x <= std::min(x1, work_.hi.x - 1); ++x) out.set(x, y);
-    }
-  }
-  return out;
+  return cells_inside(region, SliceMask(work_.lo.x, work_.lo.y, work_.hi.x - work_.lo.x, work_.hi.y - work_.lo.y),
+                      lattice_);
 }
 
 double PocketBuilder::contact_height_at(Point2 p, Part part, const std::vector<int>& tops) const {

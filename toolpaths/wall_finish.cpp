@@ -323,8 +323,9 @@ SliceMask cells_inside(const TipKeepOut& region, const SliceMask& window, const 
       }
     std::sort(crossings.begin(), crossings.end());
     for (std::size_t k = 0; k + 1 < crossings.size(); k += 2) {
-      const int x0 = int(std::ceil((crossings[k] - lattice.origin.x) / h - 0.5)),
-                x1 = int(std::floor((crossings[k + 1] - lattice.origin.x) / h - 0.5));
+      // Centres in [crossings[k], crossings[k + 1]], the ends included.
+      const int x0 = int(std::ceil((crossings[k] - lattice.origin.x) / h - 0.5 - 1e-9)),
+                x1 = int(std::floor((crossings[k + 1] - lattice.origin.x) / h - 0.5 + 1e-9));
       for (int x = std::max(x0, window.x0()); x <= std::min(x1, window.x0() + window.nx() - 1); ++x) out.set(x, y);
     }
   }

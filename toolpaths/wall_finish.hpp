@@ -99,9 +99,9 @@ TipKeepOut tip_keep_out(const std::vector<geometry::Triangle>& design, double ti
 TipKeepOut section_shrunk(const std::vector<geometry::Triangle>& design, const std::vector<double>& heights,
                           double inset, double chord_tolerance = 0.001);
 
-// The cells of `window` whose centres lie inside `region` (even-odd over its loops), row by
-// row where each row's line through the centres crosses the loops: a near-net layer's
-// cells that its beads reach.
+// The cells of `window` whose centres lie inside `region` or on its edge (even-odd over its
+// loops), row by row where each row's line through the centres crosses the loops: a
+// near-net layer's cells that its beads reach, a pocket's cells within a keep-out region.
 SliceMask cells_inside(const TipKeepOut& region, const SliceMask& window, const geometry::Lattice& lattice);
 
 // A flat end mill's bands (its defaults applied: instruments::with_defaults): the cutter
