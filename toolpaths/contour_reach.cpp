@@ -196,4 +196,25 @@ int reach_edges(std::vector<std::vector<Point2>>& chains, const SliceMask& regio
   return EdgeReacher(chains, region, inner, lattice, reach, wall).run();
 }
 
+std::vector<std::vector<Point2>> voxel_contour(const SliceMask& region, const SliceMask& wall,
+                                               const geometry::Lattice& lattice, double inset, double min_length,
+                                               EdgeReach reach, int& out_of_reach) {
+  const double h = lattice.voxel_size;
+  const SliceMask inner = shrink_by_disc(region, inset / h);
+  std::vector<std::vector<Point2>> chains;
+  for (const auto& chain : trace_chains(boundary_cells(inner))) {
+    std::vector<Point2> points;
+    double length = 0;
+    for (const Cell& cell : chain) {
+      const Point2 c{lattice.origin.x + (cell.x + 0.5) * h, lattice.origin.y + (cell.y + 0.5) * h};
+      if (!points.empty()) length += std::hypot(c.x - points.back().x, c.y - points.back().y);
+      points.push_back(c);
+    }
+    if (points.size() >= 2 && length >= min_length - 1e-9) chains.push_back(std::move(points));
+  }
+  out_of_reach = reach_edges(chains, region, inner, lattice, reach, &wall);
+  for (auto& chain : chains) chain = without_collinear(chain);
+  return chains;
+}
+
 }  // namespace hybridctl::toolpaths

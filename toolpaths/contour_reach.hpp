@@ -14,6 +14,7 @@
 // cell outside the region (air the head would lay over, or what must stay empty).
 //
 //   const int out_of_reach = reach_edges(chains, region, inner, lattice, {cover, clear}, wall);
+//   auto chains = voxel_contour(region, wall, lattice, inset, min_length, {cover, clear}, out_of_reach);
 
 #include <vector>
 
@@ -40,5 +41,13 @@ struct EdgeReach {
 // Returns how many of those cells are still farther than `cover` from every chain.
 int reach_edges(std::vector<std::vector<Point2>>& chains, const SliceMask& region, const SliceMask& inner,
                 const geometry::Lattice& lattice, EdgeReach reach, const SliceMask* wall = nullptr);
+
+// A layer's voxel contour: the boundary cells of the region shrunk by `inset` (mm), as
+// polylines through their centres at least `min_length` long, pulled out by reach_edges
+// (`wall`: material already there in the layer); `out_of_reach` counts the cells still
+// missed.
+std::vector<std::vector<Point2>> voxel_contour(const SliceMask& region, const SliceMask& wall,
+                                               const geometry::Lattice& lattice, double inset, double min_length,
+                                               EdgeReach reach, int& out_of_reach);
 
 }  // namespace hybridctl::toolpaths

@@ -13,6 +13,7 @@
 #include "instruments/bead.hpp"
 #include "instruments/support_rule.hpp"
 #include "toolpaths/contour_reach.hpp"
+#include "toolpaths/near_net_contour.hpp"
 #include "toolpaths/setup_frame.hpp"
 #include "toolpaths/slices.hpp"
 #include "toolpaths/wall_finish.hpp"
@@ -157,43 +158,6 @@ RasterResult raster_layer(const SliceMask& region, const geometry::Lattice& latt
   return out;
 }
 
-// Contour chains: the boundary cells of the region shrunk by `inset`, as polylines,
-// pulled out where the bead would not reach the region's outermost voxel centres
-// (toolpaths/contour_reach.hpp); `out_of_reach` counts the cells still missed.
-std::vector<Pass> contour_layer(const SliceMask& region, const SliceMask& wall, const geometry::Lattice& lattice,
-                                double inset, double min_length, EdgeReach reach, int& out_of_reach) {
-  const double h = lattice.voxel_size;
-  const SliceMask inner = shrink_by_disc(region, inset / h);
-  std::vector<std::vector<Vec2>> chains;
-  for (const auto& chain : trace_chains(boundary_cells(inner))) {
-    std::vector<Vec2> points;
-    double length = 0;
-    for (const Cell& cell : chain) {
-      const Vec2 c{lattice.origin.x + (cell.x + 0.5) * h, lattice.origin.y + (cell.y + 0.5) * h};
-      if (!points.empty()) length += std::hypot(c.x - points.back().x, c.y - points.back().y);
-      points.push_back(c);
-    }
-    if (points.size() >= 2 && length >= min_length - 1e-9) chains.push_back(std::move(points));
-  }
-  out_of_reach = reach_edges(chains, region, inner, lattice, reach, &wall);
-  std::vector<Pass> out;
-  for (const auto& chain : chains) {
-    Pass p;
-    for (const Vec2& c : chain) {
-      // Drop the middle point of three collinear ones.
-      if (p.points.size() >= 2) {
-        const Vec2 a = p.points[p.points.size() - 2], b = p.points.back();
-        const double cross = (b.x - a.x) * (c.y - b.y) - (b.y - a.y) * (c.x - b.x);
-        const double dot = (b.x - a.x) * (c.x - b.x) + (b.y - a.y) * (c.y - b.y);
-        if (std::abs(cross) < 1e-12 && dot > 0) p.points.pop_back();
-      }
-      p.points.push_back(c);
-    }
-    out.push_back(std::move(p));
-  }
-  return out;
-}
-
 // The machine file's documented defaults for a head built by hand with them unset.
 config::AdditiveHead with_defaults(const config::AdditiveHead& head_in) {
   if (!(head_in.bead.width > 0) || !(head_in.bead.height > 0))
@@ -231,7 +195,11 @@ class DepositionBuilder {
   // DepositionOptions::near_net_design: where the layer's bead axes may go, and the passes
   // kept there.
   std::optional<TipKeepOut> near_net_region(double zb) const;
+  // Its contour's axes: the design's sections at the band's voxel centres, the heights its
+  // region stands for (a band over a flat face holds the part above or below it only).
+  TipKeepOut near_net_contour_axes(double zb) const;
   void keep_within(const TipKeepOut& inside, std::vector<Pass>& contour, std::vector<Pass>& rasters) const;
+  void keep_pieces_within(const TipKeepOut& inside, std::vector<Pass>& rasters) const;
   // How far sideways a pass lays material at every voxel centre of the band at zb.
   double cover_of(double zb) const;
   void finish();
@@ -530,18 +498,49 @@ std::vector<Pass> DepositionBuilder::passes_of(const SliceMask& region, const Sl
   RasterResult infill;
   if (options_.contour != ContourPass::None) {
     int out_of_reach = 0;
-    contour = contour_layer(region, wall, lattice_, inset_, min_length_, {cover_of(zb), w_ / 2}, out_of_reach);
+    for (auto& chain : voxel_contour(region, wall, lattice_, inset_, min_length_, {cover_of(zb), w_ / 2}, out_of_reach))
+      contour.push_back({std::move(chain)});
     if (!contour.empty()) out_of_reach_total_ += out_of_reach;
   }
-  if (!contour.empty()) {
-    infill = raster_layer(shrink_by_disc(region, s_ / h_), lattice_, angle, s_, min_length_, inset_, reverse_start);
+  SliceMask filled = contour.empty() ? SliceMask() : shrink_by_disc(region, s_ / h_);
+  // A near-net layer's contour on the exact section (toolpaths/near_net_contour.hpp), with
+  // the rasters beside it running on towards it: it may lie farther out than the voxel
+  // contour, and rasters that stop where they stopped for that one leave voids between
+  // their ends and it. They stop a bead less a hatch spacing short of its axis: a raster
+  // along it closer than that is left out, and the next one in still meets its bead.
+  std::vector<Pass> exact;
+  std::optional<TipKeepOut> axes, rasters_within;
+  const double slack = std::max(0.0, options_.near_net_slack);
+  const NearNetBead bead{w_ / 2, w_ / 2 - slack, w_ / 2 + slack, min_length_};
+  if (within && !contour.empty()) {
+    std::vector<std::vector<Vec2>> chains;
+    for (Pass& p : contour) chains.push_back(std::move(p.points));
+    axes = near_net_contour_axes(zb);
+    NearNetContour c = near_net_contour(*axes, region, chains, lattice_, bead);
+    contour.clear();
+    for (auto& line : c.voxel) contour.push_back({std::move(line)});
+    for (auto& line : c.exact) exact.push_back({std::move(line)});
+    if (!exact.empty()) {
+      SliceMask beside = grow_by_disc(c.exact_cells, (s_ + w_) / h_);
+      beside &= region;
+      filled |= beside;
+      rasters_within = axes->grown(-std::max(0.0, w_ - s_));
+    }
+  }
+  if (!contour.empty() || !exact.empty()) {
+    infill = raster_layer(filled, lattice_, angle, s_, min_length_, inset_, reverse_start);
   } else {
     // No contour fits (a region narrower than a bead everywhere): rasters alone, whose
     // segments along the region may still fit, and whose dropped ones are counted.
     infill = raster_layer(region, lattice_, angle, s_, min_length_, inset_, reverse_start, &wall);
   }
   dropped_total_ += infill.dropped;
+  if (rasters_within) {
+    keep_pieces_within(*rasters_within, infill.passes);
+    for (auto& line : near_net_gap_loops(*axes, region, lattice_, bead, s_)) exact.push_back({std::move(line)});
+  }
   if (within) keep_within(*within, contour, infill.passes);
+  contour.insert(contour.begin(), exact.begin(), exact.end());
   std::vector<Pass> passes;
   if (options_.contour == ContourPass::BeforeInfill) passes = contour;
   passes.insert(passes.end(), infill.passes.begin(), infill.passes.end());
@@ -561,6 +560,14 @@ std::optional<TipKeepOut> DepositionBuilder::near_net_region(double zb) const {
   return inside;
 }
 
+TipKeepOut DepositionBuilder::near_net_contour_axes(double zb) const {
+  std::vector<double> heights;
+  const int k_lo = int(std::ceil((zb - oz_) / h_ - 0.5 - 1e-9)), k_hi = int(std::ceil((zb + lh_ - oz_) / h_ - 0.5 - 1e-9)) - 1;
+  for (int k = k_lo; k <= k_hi; ++k) heights.push_back(oz_ + (k + 0.5) * h_);
+  if (heights.empty()) heights.push_back(zb + lh_ / 2);
+  return section_shrunk(*options_.near_net_design, heights, w_ / 2 - std::max(0.0, options_.near_net_slack));
+}
+
 void DepositionBuilder::keep_within(const TipKeepOut& inside, std::vector<Pass>& contour, std::vector<Pass>& rasters) const {
   for (Pass& p : contour)
     for (Vec2& q : p.points) {
@@ -572,6 +579,10 @@ void DepositionBuilder::keep_within(const TipKeepOut& inside, std::vector<Pass>&
     p.points.erase(std::unique(p.points.begin(), p.points.end(),
                                [](Vec2 a, Vec2 b) { return std::hypot(a.x - b.x, a.y - b.y) < 1e-9; }),
                    p.points.end());
+  keep_pieces_within(inside, rasters);
+}
+
+void DepositionBuilder::keep_pieces_within(const TipKeepOut& inside, std::vector<Pass>& rasters) const {
   std::vector<Pass> kept;
   for (const Pass& p : rasters) {
     // A raster kept whole stays, however short its inset left it; a piece cut off by the

@@ -169,9 +169,11 @@ TEST_F(WholePlan, TheBossPlateIsDepositedAndMilledForLessThanMillingItFromTheBlo
 
 // A repair (issue 16): the worn copy of the flanged hub (2.5 mm gone from half of the
 // flange's top) given as the stock. Every plan starts from it and deposits only what it
-// lacks; one deposits the neighbourhood of the missing region with overfill and mills the
-// top back flat, and every plan offered, run from the worn part on its own simulated
-// controller, makes the hub within tolerance both ways with no alarm.
+// lacks; the best lays the missing region near-net and leaves it as deposited, and every
+// plan offered, run from the worn part on its own simulated controller, makes the hub
+// within tolerance both ways with no alarm. (Until stop 52 three more plans laid the region
+// near-net and then overfilled around it: the near-net beads now stand on the design's
+// real rim, past the voxels, and the overfill's first layers lie under them.)
 TEST_F(WholePlan, AWornHubIsRepairedByDepositingOnlyWhatItLacksAndEveryPlanRunsWithinTolerance) {
   const std::string source = HYBRIDCTL_SOURCE_DIR;
   // At 0.7 mm: the repaired faces stay as deposited, within the powder head's 0.25 mm of
@@ -179,20 +181,22 @@ TEST_F(WholePlan, AWornHubIsRepairedByDepositingOnlyWhatItLacksAndEveryPlanRunsW
   const Outcome r = run({"dry-run", kFlangedHub, "--machine", kMachine, "--voxel", "0.5", "--tolerance", "0.7", "--stock",
                          source + "/examples/parts/flanged-hub-worn.stl", "--all", "-o", (dir_ / "dry").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
-  EXPECT_NE(r.out.find("dry-run     5 of 5 plans ran to the end with no alarm, within tolerance both ways"), std::string::npos)
+  std::smatch ran;
+  ASSERT_TRUE(std::regex_search(r.out, ran, std::regex("dry-run     ([0-9]+) of \\1 plans ran to the end with no alarm, "
+                                                       "within tolerance both ways")))
       << r.out;
-  // "  3. (((P1 ∪ P2) ∪ P17) − P6)": the stock, the deposit near the missing region, a removal.
-  const std::regex local("\\n  (P[0-9]+) +O-AM ded from \\+Z \\(top\\), near the missing 2454 mm");
+  EXPECT_GE(std::stoi(ran[1]), 2);
+  // "  1. (P1 ∪ P16)": the stock and the near-net deposit near the missing region.
+  const std::regex local("\\n  (P[0-9]+) +U-AM ded from \\+Z \\(top\\), near the missing 2454 mm");
   std::smatch m;
   ASSERT_TRUE(std::regex_search(r.out, m, local)) << r.out;
-  const std::regex repair("\\n  [0-9]\\. \\(+P1 [^\\n]*∪ " + std::string(m[1]) + "\\) − P[0-9]+\\)  cost");
-  EXPECT_TRUE(std::regex_search(r.out, repair)) << r.out;
+  EXPECT_NE(r.out.find("\n  1. (P1 ∪ " + std::string(m[1]) + ")  cost"), std::string::npos) << r.out;
   // Every action after the stock deposits at most the missing 2,454 mm³ and its overfill.
   const std::regex deposit("\\n     [0-9]\\) P[0-9]+ +[UO]-AM [^\\n]* deposit +([0-9.]+) mm");
   int deposits = 0;
   for (auto it = std::sregex_iterator(r.out.begin(), r.out.end(), deposit); it != std::sregex_iterator(); ++it, ++deposits)
     EXPECT_LT(std::stod((*it)[1]), 2454 * 1.2) << it->str();
-  EXPECT_GE(deposits, 5);
+  EXPECT_GE(deposits, 2);
 }
 
 // hybridctl export as a user runs it, on the bundled example parts that have valid plans on

@@ -2,6 +2,7 @@
 // Small meshes with known volumes, built in code so tests say exactly what they hold.
 
 #include <cmath>
+#include <vector>
 
 #include "geometry/mesh.hpp"
 
@@ -37,6 +38,32 @@ inline TriangleMesh sphere_mesh(Vec3 c, double r, int rings = 24, int segments =
       if (i != rings - 1) m.triangles.push_back({d, b, e});
     }
   return m;
+}
+
+// A convex polygon (counter-clockwise, x and y of each point) extruded from z0 to z1:
+// closed and outward-oriented.
+inline TriangleMesh prism_mesh(const std::vector<Vec3>& polygon, double z0, double z1) {
+  TriangleMesh m;
+  const std::size_t n = polygon.size();
+  const auto at = [&](std::size_t i, double z) { return Vec3{polygon[i % n].x, polygon[i % n].y, z}; };
+  for (std::size_t i = 1; i + 1 < n; ++i) {
+    m.triangles.push_back({at(0, z0), at(i + 1, z0), at(i, z0)});
+    m.triangles.push_back({at(0, z1), at(i, z1), at(i + 1, z1)});
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    m.triangles.push_back({at(i, z0), at(i + 1, z0), at(i + 1, z1)});
+    m.triangles.push_back({at(i, z0), at(i + 1, z1), at(i, z1)});
+  }
+  return m;
+}
+
+// A bar `width` wide from `from` to `to` (x and y), standing from z0 to z1.
+inline TriangleMesh bar_mesh(Vec3 from, Vec3 to, double width, double z0, double z1) {
+  const double len = std::hypot(to.x - from.x, to.y - from.y);
+  const double nx = -(to.y - from.y) / len * width / 2, ny = (to.x - from.x) / len * width / 2;
+  return prism_mesh({{from.x - nx, from.y - ny, 0}, {to.x - nx, to.y - ny, 0}, {to.x + nx, to.y + ny, 0},
+                     {from.x + nx, from.y + ny, 0}},
+                    z0, z1);
 }
 
 inline TriangleMesh joined(TriangleMesh a, const TriangleMesh& b) {

@@ -15,6 +15,7 @@
 
 #include "toolpaths/setup_frame.hpp"
 #include "geometry/shapes.hpp"
+#include "geometry/voxelize.hpp"
 #include "toolpath_oracles.hpp"
 #include "../geometry/mesh_fixtures.hpp"
 
@@ -173,7 +174,9 @@ TEST(DepositionPath, ContourPassesStayInTheRegionToo) {
 // A wall whose faces run through voxel centres (y = 2.25 and 4.75 on 0.5 mm voxels): the
 // voxel region holds the centres on the faces, and on the voxels alone the contour is
 // pulled out to cover them, its bead past the faces. Given the design, a near-net
-// deposit's beads end on its real faces: every bead's axis at least half a bead inside.
+// deposit's beads end on its real faces: along them every bead's axis is at least half a
+// bead inside. At the corners the bead stands a little past them so as to reach the
+// corner itself (toolpaths/near_net_contour.hpp, corners_reaching).
 TEST(DepositionPath, ANearNetDepositsBeadsEndOnTheDesignsRealWalls) {
   const geometry::TriangleMesh wall = geometry::testing::box_mesh({2.25, 2.25, 0}, {14.75, 4.75, 1.8});
   const Solid roi = make_box(kLattice, {{2, 2, 0}, {15, 5, 1.8}});  // the voxels whose centres lie in the wall
@@ -183,9 +186,19 @@ TEST(DepositionPath, ANearNetDepositsBeadsEndOnTheDesignsRealWalls) {
     double worst = -1e9;
     for (const Segment& s : deposition_segments(p))
       along(s.a, s.b, 0.05, [&](Vec3 q) {
-        worst = std::max({worst, 2.25 - (q.y - half_bead), (q.y + half_bead) - 4.75, 2.25 - (q.x - half_bead),
-                          (q.x + half_bead) - 14.75});
+        if (q.x > 2.25 + 2 * half_bead && q.x < 14.75 - 2 * half_bead)
+          worst = std::max({worst, 2.25 - (q.y - half_bead), (q.y + half_bead) - 4.75});
       });
+    return worst;
+  };
+  const auto farthest_corner = [&](const Toolpath& p) {
+    double worst = 0;
+    for (Vec3 corner : {Vec3{2.25, 2.25, 0}, Vec3{2.25, 4.75, 0}, Vec3{14.75, 2.25, 0}, Vec3{14.75, 4.75, 0}}) {
+      double best = 1e9;
+      for (const Segment& s : deposition_segments(p))
+        along(s.a, s.b, 0.01, [&](Vec3 q) { best = std::min(best, std::hypot(q.x - corner.x, q.y - corner.y)); });
+      worst = std::max(worst, best);
+    }
     return worst;
   };
   DepositionOptions on_voxels;
@@ -195,10 +208,51 @@ TEST(DepositionPath, ANearNetDepositsBeadsEndOnTheDesignsRealWalls) {
   near_net.near_net_design = std::make_shared<const std::vector<geometry::Triangle>>(wall.triangles);
   const Toolpath exact = deposition_path(roi, Solid(kLattice, {}), head, top_setup(), near_net);
   EXPECT_LE(worst_past_a_face(exact), 0.002);
+  EXPECT_LE(farthest_corner(exact), half_bead + 0.01) << "every corner within the bead";
   // It still lays the wall: every layer, with its contour and rasters.
   EXPECT_GE(layer_count(exact), layer_count(voxels));
   EXPECT_GE(deposition_segments(exact).size(), deposition_segments(voxels).size() / 2);
   expect_segments_in_region(exact, roi, head.layer_height);
+}
+
+// A blade 2.5 mm thick at 60 degrees to X on a plate, as the bladed disc's: on 0.5 mm
+// voxels its faces are staircases, and the voxel contour zigzags inside it and left one
+// face's bead out (0.754 mm short on the disc as deposited). Near-net, every layer from the
+// plate up, the one whose band holds the plate's top included, has a bead's axis within
+// half a bead (less the slack) of every point of both faces.
+TEST(DepositionPath, ANearNetDepositLaysBothFacesOfABladeAcrossTheGrid) {
+  const double c = std::cos(std::numbers::pi / 3), s = std::sin(std::numbers::pi / 3);
+  const Vec3 from{6, 3, 0}, to{6 + 14 * c, 3 + 14 * s, 0};
+  const geometry::TriangleMesh design = geometry::testing::joined(
+      geometry::testing::box_mesh({0, 0, 0}, {20, 20, 2}), geometry::testing::bar_mesh(from, to, 2.5, 2, 6));
+  const Solid roi = geometry::voxelize(design, kLattice, "design");
+  const double half_bead = ded_head().bead.width / 2, slack = 0.125;
+  DepositionOptions near_net;
+  near_net.near_net_design = std::make_shared<const std::vector<geometry::Triangle>>(design.triangles);
+  near_net.near_net_slack = slack;
+  const Toolpath p = deposition_path(roi, Solid(kLattice, {}), ded_head(), top_setup(), near_net);
+  std::map<double, std::vector<Segment>> layers;
+  for (const Segment& seg : deposition_segments(p)) layers[std::round(seg.a.z * 1e6) / 1e6].push_back(seg);
+  const auto farthest_face_point = [&](const std::vector<Segment>& segs) {
+    const Vec3 n{-s * 1.25, c * 1.25, 0};
+    double worst = 0;
+    for (double t = 1.5; t <= 12.5; t += 0.1)
+      for (double side : {-1.0, 1.0}) {
+        const Vec3 q{from.x + t * c + side * n.x, from.y + t * s + side * n.y, 0};
+        double best = 1e9;
+        for (const Segment& seg : segs)
+          along(seg.a, seg.b, 0.02, [&](Vec3 a) { best = std::min(best, std::hypot(a.x - q.x, a.y - q.y)); });
+        worst = std::max(worst, best);
+      }
+    return worst;
+  };
+  int blade_layers = 0;
+  for (const auto& [z, segs] : layers) {
+    if (z + 0.6 <= 2 + 1e-9) continue;  // the plate's layers
+    ++blade_layers;
+    EXPECT_LE(farthest_face_point(segs), half_bead - slack + 0.01) << "layer at z = " << z;
+  }
+  EXPECT_EQ(blade_layers, 7) << "the layers from 1.8 (its band holds the plate's top) to 5.4";
 }
 
 // The head's 0.6 mm layers over a wall 2 mm tall: 0.6, 1.2, 1.8, and the last bead's top
