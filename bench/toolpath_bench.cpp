@@ -5,6 +5,9 @@
 //   - Z-level pocketing of a 50 x 50 x 50 mm pocket around a round boss with the bundled
 //     10 mm flat rougher (5 mm step down, 4 mm step over, 42 mm holder), zigzag and
 //     contour-parallel rings, and with the 3 mm flat detail tool (1 mm step down);
+//   - the bundled bladed disc's hub and blades laid from its base disc by the DED head:
+//     the voxel contour (arg 0) and near-net on the STL's exact sections (arg 1,
+//     toolpaths/near_net_contour.hpp): their ratio is what the exact contour costs;
 //   - the bundled rounded box with its dimple milled from a block over it by the B-axis
 //     machine's 8 mm ball (0.4 mm step down), Z-levels alone (arg 0) and with surface
 //     finishing on the STL at a 0.1 mm scallop (arg 1): their ratio is what finishing adds.
@@ -106,6 +109,25 @@ void BM_Deposition(benchmark::State& state) {
   count(state, p, roi);
 }
 
+void BM_NearNetDisc(benchmark::State& state) {
+  const auto mesh = std::make_shared<const std::vector<geometry::Triangle>>(
+      geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/bladed-disc.stl").triangles);
+  const Solid design = geometry::voxelize(geometry::TriangleMesh{*mesh}, kLattice, "bladed disc");
+  const Solid base = geometry::intersect(design, geometry::make_box(kLattice, {{-1, -1, -1}, {61, 61, 2}}));
+  const Solid roi = geometry::subtract(design, base);
+  toolpaths::DepositionOptions o;
+  if (state.range(0)) {
+    o.near_net_design = mesh;
+    o.near_net_slack = 0.125;  // hybrid-3axis: (0.5 mm tolerance - 0.25 mm accuracy) / 2
+  }
+  gcode::Toolpath p;
+  for (auto _ : state) {
+    p = toolpaths::deposition_path(roi, base, ded(), top(), o);
+    benchmark::DoNotOptimize(p.moves.data());
+  }
+  count(state, p, roi);
+}
+
 void pocket(benchmark::State& state, const config::CuttingTool& tool, toolpaths::PocketStrategy strategy) {
   const Solid stock = geometry::make_box(kLattice, {{0, 0, 0}, {60, 60, 55}});
   Solid roi = geometry::make_box(kLattice, {{5, 5, 5}, {55, 55, 55}});
@@ -164,11 +186,13 @@ void register_smoke_cases() {
                           hybridctl::bench::NamedCase{"BM_PocketZigzag_Detail", BM_PocketZigzag_Detail}})
     hybridctl::bench::smoke_case(name, fn)->Unit(benchmark::kMillisecond);
   hybridctl::bench::smoke_case("BM_BallOnTheRoundedBox", BM_BallOnTheRoundedBox)->Arg(1)->Unit(benchmark::kMillisecond);
+  hybridctl::bench::smoke_case("BM_NearNetDisc", BM_NearNetDisc)->Arg(1)->Unit(benchmark::kMillisecond);
 }
 
 }  // namespace
 
 BENCHMARK(BM_Deposition)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_NearNetDisc)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_PocketZigzag_Rougher)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_PocketOffsets_Rougher)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_PocketZigzag_Detail)->Unit(benchmark::kMillisecond)->UseRealTime();

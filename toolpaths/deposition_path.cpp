@@ -506,8 +506,9 @@ std::vector<Pass> DepositionBuilder::passes_of(const SliceMask& region, const Sl
   // A near-net layer's contour on the exact section (toolpaths/near_net_contour.hpp), with
   // the rasters beside it running on towards it: it may lie farther out than the voxel
   // contour, and rasters that stop where they stopped for that one leave voids between
-  // their ends and it. They stop a bead less a hatch spacing short of its axis: a raster
-  // along it closer than that is left out, and the next one in still meets its bead.
+  // their ends and it. They stop a bead less a hatch spacing short of its axis, and
+  // 15 % of a bead less again: a raster along it closer than that is left out, and the next
+  // one in still overlaps its bead (by no less than the margin).
   std::vector<Pass> exact;
   std::optional<TipKeepOut> axes, rasters_within;
   const double slack = std::max(0.0, options_.near_net_slack);
@@ -524,7 +525,7 @@ std::vector<Pass> DepositionBuilder::passes_of(const SliceMask& region, const Sl
       SliceMask beside = grow_by_disc(c.exact_cells, (s_ + w_) / h_);
       beside &= region;
       filled |= beside;
-      rasters_within = axes->grown(-std::max(0.0, w_ - s_));
+      rasters_within = axes->grown(-std::max(0.0, 0.85 * w_ - s_));
     }
   }
   if (!contour.empty() || !exact.empty()) {
