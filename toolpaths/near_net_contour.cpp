@@ -81,18 +81,19 @@ std::vector<std::vector<Point2>> kept_pieces(const std::vector<Point2>& line, Ke
 }
 
 // The runs of `loops` where `keep` holds and that are `min_length` long, with the cells
-// they run through set in `cells`.
+// they run through set in `cells` when given.
 template <class Keep>
 std::vector<std::vector<Point2>> runs_of(const std::vector<std::vector<Point2>>& loops, Keep keep,
-                                         const geometry::Lattice& lattice, double min_length, SliceMask& cells) {
+                                         const geometry::Lattice& lattice, double min_length, SliceMask* cells) {
   std::vector<std::vector<Point2>> out;
   for (const auto& loop : loops)
     for (auto& run : kept_runs(densified(loop, lattice.voxel_size / 2, true), keep)) {
       if (run.size() < 2 || length_of(run) < min_length - 1e-9) continue;
-      for (const Point2& p : run) {
-        const Cell c = cell_of(p, lattice);
-        cells.set(c.x, c.y);
-      }
+      if (cells)
+        for (const Point2& p : run) {
+          const Cell c = cell_of(p, lattice);
+          cells->set(c.x, c.y);
+        }
       out.push_back(without_collinear(run));
     }
   return out;
@@ -118,13 +119,17 @@ std::vector<Point2> corners_reaching(const std::vector<Point2>& loop, const Near
   for (std::size_t i = 0; i < n; ++i) {
     const Point2 p = away(i, -1), v = loop[i], q = away(i, +1);
     const double l1 = std::hypot(v.x - p.x, v.y - p.y), l2 = std::hypot(q.x - v.x, q.y - v.y);
+    if (!(l1 > 0) || !(l2 > 0)) {  // a loop shorter than a corner's sides
+      out.push_back(v);
+      continue;
+    }
     const Point2 e1{(v.x - p.x) / l1, (v.y - p.y) / l1}, e2{(q.x - v.x) / l2, (q.y - v.y) / l2};
     const Point2 out_dir{e1.x - e2.x, e1.y - e2.y};
     const double len = std::hypot(out_dir.x, out_dir.y);
     // The region on the right: a convex corner turns right. |e1 - e2| is 2 sin(turn / 2);
     // the design's corner lies inset / cos(turn / 2) out along the bisector. A spike's
     // corner is farther than a bead can follow: at most half a bead out.
-    const bool convex = l1 > 0 && l2 > 0 && len > 1e-9 && e1.x * e2.y - e1.y * e2.x < 0;
+    const bool convex = len > 1e-9 && e1.x * e2.y - e1.y * e2.x < 0;
     const double cos_half_turn = std::sqrt(std::max(0.0, 1 - len * len / 4));
     const double move = !convex                ? 0
                         : cos_half_turn > 1e-9 ? bead.axis_inset / cos_half_turn - bead.corner_reach
@@ -152,7 +157,7 @@ NearNetContour near_net_contour(const TipKeepOut& axes, const SliceMask& region,
   std::vector<std::vector<Point2>> reaching;
   for (const auto& loop : axes.loops()) reaching.push_back(corners_reaching(loop, bead));
   out.exact = runs_of(reaching, [&](Point2 p) { return region.at(cell_of(p, lattice)); }, lattice, bead.min_length,
-                      out.exact_cells);
+                      &out.exact_cells);
   if (out.exact.empty()) {
     out.voxel = voxel_chains;
     return out;
@@ -175,10 +180,9 @@ std::vector<std::vector<Point2>> near_net_gap_loops(const TipKeepOut& axes, cons
   // Where the middle is a hatch spacing wide, rasters run across it; elsewhere it is a
   // sliver they only cross, leaving what lies between them.
   const TipKeepOut wide = middle.grown(-hatch_spacing / 2).grown(hatch_spacing / 2 + 0.02);
-  SliceMask cells(region.x0(), region.y0(), region.nx(), region.ny());
   return runs_of(middle.loops(),
                  [&](Point2 p) { return region.at(cell_of(p, lattice)) && (wide.empty() || !wide.contains(p)); },
-                 lattice, bead.min_length, cells);
+                 lattice, bead.min_length, nullptr);
 }
 
 }  // namespace hybridctl::toolpaths
