@@ -77,7 +77,7 @@ double plate_z(const plan::PlanFile& file, const geometry::IndexBox& simulated, 
 // removal finishes its walls on, or null for one that cuts into the design on purpose.
 void make_program(const plan::PlanFile& file, const geometry::IndexBox& simulated, const plan::PlanFilePrimitive& p,
                   const config::Machine& machine, const ExportOptions& options, ExportedAction& a,
-                  const geometry::Solid* counted_on, DesignFrames* design) {
+                  const geometry::Solid* counted_on, DesignFrames* design, const geometry::Solid* laid) {
   const config::Setup& setup = setup_named(machine, p);
   ActionProgram& prog = a.program;
   prog.action = a.step;
@@ -118,6 +118,7 @@ void make_program(const plan::PlanFile& file, const geometry::IndexBox& simulate
       // what the finishing's thinning and the controller's rounding add.
       if (file.tolerance > 0) pocket.scallop = file.tolerance / 3;
       pocket.finish_region = &p.region;
+      pocket.laid = laid;
     }
     prog.path = pocket_path(a.roi, a.after, a.before, *tool, setup, pocket);
   }
@@ -165,7 +166,7 @@ void check_machine(const plan::PlanFile& file, const config::Machine& machine) {
 ExportedAction make_action(int k, geometry::Solid before, const geometry::Solid* after, const geometry::IndexBox& simulated,
                            const plan::PlanFile& file, const plan::PlanFilePlan& plan,
                            const config::Machine& machine, const ExportOptions& options, DesignFrames& design,
-                           const geometry::Solid* planned_before = nullptr) {
+                           const geometry::Solid& laid, const geometry::Solid* planned_before = nullptr) {
   const plan::PlanFilePrimitive& p = file.primitives.at(std::size_t(plan.actions.at(std::size_t(k)).primitive));
   const bool additive = p.mode == config::Mode::Additive;
   ExportedAction a;
@@ -176,7 +177,7 @@ ExportedAction make_action(int k, geometry::Solid before, const geometry::Solid*
   a.roi = additive ? subtract(p.region, a.before) : intersect(a.before, p.region);
   if (p.raw_stock()) {
     a.note = "clamp the raw stock: " + p.label;
-  } else if (a.roi.empty()) {
+  } else if (a.roi.empty() && (additive || laid.empty())) {
     a.note = "nothing to " + std::string(additive ? "deposit" : "remove") + " in this state";
   } else if (p.kind == config::PrimitiveKind::File) {
     throw InputError(p.name + " is a primitive from the file " + p.capability +
@@ -199,28 +200,54 @@ ExportedAction make_action(int k, geometry::Solid before, const geometry::Solid*
       }
     }
     make_program(file, simulated, p, machine, options, a, counted_on ? &*counted_on : nullptr,
-                 cuts_design ? nullptr : &design);
+                 cuts_design ? nullptr : &design, &laid);
+    // A removal that meets no voxel and finds no laid wall next to its region to finish.
+    if (a.roi.empty() && !a.makes_gcode) a.note = "nothing to remove in this state";
   }
   return a;
 }
 
-// Actions `first`.. of the plan into `out`; `present` is the material the first one meets
-// when the material present is fed back, `planned` the planned states otherwise.
+// What deposits laid that no removal has finished, after action `a` (`laid`: before it):
+// a deposit adds its region of influence (the raw stock is no deposit); a removal takes
+// what it cut and, when it finishes walls, the material next to its region.
+geometry::Solid laid_after(geometry::Solid laid, const plan::PlanFilePrimitive& p, const ExportedAction& a, bool finishes) {
+  if (p.raw_stock()) return laid;
+  if (p.mode == config::Mode::Additive) return geometry::unite(laid, a.roi);
+  if (laid.empty()) return laid;
+  laid = geometry::subtract(laid, a.roi);
+  if (finishes) laid = geometry::subtract(laid, geometry::dilate(p.region, geometry::Ball{1.5 * p.region.lattice().voxel_size}));
+  return laid;
+}
+
+// Whether removal `p` finishes the walls next to its region on the STL (toolpaths/pocket_path.hpp).
+bool finishes_walls(const plan::PlanFilePrimitive& p, const config::Machine& machine, const ExportOptions& options) {
+  if (p.mode != config::Mode::Subtractive || !options.pocket.finish_walls) return false;
+  const config::CuttingTool* tool = machine.find_tool(p.tool_number);
+  return tool && tool->type == config::ToolType::Flat;
+}
+
+// Actions `first`.. of the plan into `out` (which holds those before); `present` is the
+// material the first one meets when the material present is fed back, `planned` the
+// planned states otherwise.
 void export_from(int first, geometry::Solid present, const std::vector<geometry::Solid>& planned,
                  const plan::PlanFile& file, const plan::PlanFilePlan& plan, const config::Machine& machine,
                  const ExportOptions& options, const MaterialAfter& material_after, PlanExport& out) {
   const int n = int(plan.actions.size());
   const geometry::IndexBox simulated = plan::simulated_domain(file, plan, machine);
   DesignFrames design(file.design_mesh);
+  geometry::Solid laid = first > 0 ? out.actions.at(std::size_t(first) - 1).laid : geometry::Solid(file.lattice, {});
   for (int k = first; k < n; ++k) {
     if (options.progress) options.progress(k + 1, n);
     const plan::PlanFilePrimitive& p = file.primitives[std::size_t(plan.actions[std::size_t(k)].primitive)];
     if (p.raw_stock()) out.raw_stock = p.label;
     const geometry::Solid* planned_before = planned.empty() ? nullptr : &planned[std::size_t(k)];
     ExportedAction a = material_after
-                           ? make_action(k, present, nullptr, simulated, file, plan, machine, options, design, planned_before)
+                           ? make_action(k, present, nullptr, simulated, file, plan, machine, options, design, laid,
+                                         planned_before)
                            : make_action(k, planned[std::size_t(k)], &planned[std::size_t(k) + 1], simulated, file, plan,
-                                         machine, options, design);
+                                         machine, options, design, laid);
+    laid = laid_after(std::move(laid), p, a, finishes_walls(p, machine, options));
+    a.laid = laid;
     if (material_after) present = material_after(a);
     out.actions.push_back(std::move(a));
   }
@@ -268,8 +295,19 @@ ExportedAction export_planned_action(const plan::PlanFile& file, const plan::Pla
     throw std::invalid_argument("export_planned_action: no action " + std::to_string(k) + " or not the plan's states");
   check_machine(file, machine);
   DesignFrames design(file.design_mesh);
-  return make_action(k, planned[std::size_t(k)], &planned[std::size_t(k) + 1], plan::simulated_domain(file, plan, machine),
-                     file, plan, machine, options, design);
+  geometry::Solid laid(file.lattice, {});
+  for (int j = 0; j < k; ++j) {
+    const plan::PlanFilePrimitive& p = file.primitives.at(std::size_t(plan.actions[std::size_t(j)].primitive));
+    ExportedAction a;
+    a.roi = p.mode == config::Mode::Additive ? subtract(p.region, planned[std::size_t(j)])
+                                             : intersect(planned[std::size_t(j)], p.region);
+    laid = laid_after(std::move(laid), p, a, finishes_walls(p, machine, options));
+  }
+  ExportedAction a = make_action(k, planned[std::size_t(k)], &planned[std::size_t(k) + 1],
+                                 plan::simulated_domain(file, plan, machine), file, plan, machine, options, design, laid);
+  a.laid = laid_after(std::move(laid), file.primitives.at(std::size_t(plan.actions[std::size_t(k)].primitive)), a,
+                      finishes_walls(file.primitives.at(std::size_t(plan.actions[std::size_t(k)].primitive)), machine, options));
+  return a;
 }
 
 }  // namespace hybridctl::toolpaths

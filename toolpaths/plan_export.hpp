@@ -48,6 +48,9 @@ struct ExportedAction {
   geometry::Solid before;      // material the action meets (part frame): planned, or present (material_after)
   geometry::Solid after;       // `before` with the action's primitive applied (AM unites, SM subtracts)
   geometry::Solid roi;         // its region of influence in `before`
+  // After it, what deposits laid that no removal has finished since (part frame): a later
+  // removal finishes the walls of it next to its region (PocketOptions::laid).
+  geometry::Solid laid;
   ActionProgram program;       // when makes_gcode; a path with no move keeps its defects here
 };
 

@@ -59,8 +59,10 @@ class PocketBuilder {
   // `design`: the design's voxels in the work frame, or null (then made from
   // PocketOptions::design when finishing); `finish_region`: PocketOptions::finish_region in
   // the work frame, or null for the ROI.
+  // `laid`: PocketOptions::laid in the work frame, or null.
   Toolpath& run(const geometry::Solid& roi, const geometry::Solid& keep, const geometry::Solid& stock,
-                const geometry::Solid* design = nullptr, const geometry::Solid* finish_region = nullptr);
+                const geometry::Solid* design = nullptr, const geometry::Solid* finish_region = nullptr,
+                const geometry::Solid* laid = nullptr);
 
  private:
   using Solid = geometry::Solid;
@@ -75,6 +77,15 @@ class PocketBuilder {
   Solid allowed_tips() const;
   void start_column_tops();
   Levels cutting_levels() const;
+  // Whether this run can finish walls on the STL (a flat cutter, given the design).
+  bool finishes_walls() const;
+  // The walls of laid material next to the region: the levels that finish them, and where
+  // that material is (voxel indices, work frame; empty when none).
+  struct LaidWalls {
+    Levels levels;
+    IndexBox box;
+  };
+  LaidWalls laid_walls(const Solid& laid, const Solid& region) const;
   void held_rows(int y, int z, std::vector<std::uint64_t>& held) const;
   SliceMask usable_tips(const Solid& allowed, int k) const;
   SliceMask useful_tips(const SliceMask& usable, int k) const;
@@ -146,6 +157,9 @@ class PocketBuilder {
   // the boundary of `keep_out`, where they finish what level k removes (the ROI's layers
   // [k, k_above)).
   void finish_walls(const TipKeepOut& keep_out, int k, int k_above, double z);
+  // The finishing passes under the lowest level (k_low, its tip at z_low), for what a
+  // deposit laid below its voxels.
+  void finish_walls_below(int k_low, double z_low);
   // What those passes must keep clear of; nothing when no wall there is this level's.
   std::optional<FinishLevel> finish_level(const TipKeepOut& keep_out, int k, int k_above, double z) const;
   std::optional<std::vector<Point2>> finish_lead(const FinishLevel& f, Point2 p, Point2 t, bool in) const;

@@ -541,4 +541,23 @@ void PocketBuilder::finish_walls(const TipKeepOut& keep_out, int k, int k_above,
   retract();
 }
 
+// A deposit's beads stand past the voxels they fill, below them too: its layers keep
+// their own heights, not the lattice's (the worn hub's overfill, laid from z = 32.3 mm
+// under voxels from 32.5). So the walls next to the region are finished on down to
+// material_allowance under the lowest level, a layer at a time (and from the faces square
+// to the axis between), wherever finish_level finds a wall there the region borders.
+void PocketBuilder::finish_walls_below(int k_low, double z_low) {
+  const double bottom = lattice_.origin.z + k_low * h_ - options_.material_allowance;
+  int k_above = k_low;
+  double z_above = z_low;
+  for (int k = k_low - 1; centre_z(k) >= bottom - 1e-9; --k) {
+    const double z = centre_z(k);
+    finish_walls(keep_out_at(z), k, k_above, z);
+    for (const double zf : face_heights_)
+      if (zf > z + 1e-6 && zf < z_above - 1e-6) finish_walls(keep_out_at(zf), k, k_above, zf);
+    k_above = k;
+    z_above = z;
+  }
+}
+
 }  // namespace hybridctl::toolpaths::pocket

@@ -211,11 +211,7 @@ bool PocketBuilder::take_material(const Solid& roi, const Solid& keep, const Sol
   all_ = geometry::box_union(roi.bounding_box(), geometry::box_union(keep.bounding_box(), stock.bounding_box()));
   safe_z_ = (all_.empty() ? lattice_.origin.z : lattice_.origin.z + all_.hi.z * h_) + options_.safe_clearance;
   path_.safe_z = safe_z_;
-  if (remaining_.bounding_box().empty()) {
-    path_.warnings.push_back("nothing to remove: the region of influence holds no material");
-    return false;
-  }
-  return true;
+  return !remaining_.bounding_box().empty();
 }
 
 // The whole tool clear of `untouchable`, at this height and every height above it (so
@@ -242,6 +238,33 @@ void PocketBuilder::start_column_tops() {
   untouchable_tops_ = column_top_indices(untouchable_, tops_box_);
   tops_ = untouchable_tops_;
   refresh_tops(tops_box_);
+}
+
+bool PocketBuilder::finishes_walls() const {
+  return options_.finish_walls && options_.design && !options_.design->empty() && tool_.type == config::ToolType::Flat;
+}
+
+// The layers where material a deposit laid borders the region the action may remove
+// (within 1.5 voxels in the layer): levels every step-down from the highest down to the
+// lowest, and the box of those cells.
+PocketBuilder::LaidWalls PocketBuilder::laid_walls(const Solid& laid, const Solid& region) const {
+  LaidWalls out;
+  const IndexBox rb = region.bounding_box();
+  const IndexBox b = geometry::box_intersection(
+      laid.bounding_box(), {{rb.lo.x - 2, rb.lo.y - 2, rb.lo.z}, {rb.hi.x + 2, rb.hi.y + 2, rb.hi.z}});
+  if (b.empty()) return out;
+  const IndexBox window{{b.lo.x - 2, b.lo.y - 2, b.lo.z}, {b.hi.x + 2, b.hi.y + 2, b.hi.z}};
+  for (int k = b.lo.z; k < b.hi.z; ++k) {
+    SliceMask beside = slice_of(laid, k, window);
+    if (beside.empty()) continue;
+    beside &= grow_by_disc(slice_of(region, k, window), 1.5);
+    const CellBox cells = cell_bounds(beside);
+    if (!cells.empty()) out.box = geometry::box_union(out.box, {{cells.x0, cells.y0, k}, {cells.x1, cells.y1, k + 1}});
+  }
+  if (out.box.empty()) return out;
+  for (int k = out.box.hi.z - 1; k > out.box.lo.z; k -= down_) out.levels.insert(k);
+  out.levels.insert(out.box.lo.z);
+  return out;
 }
 
 // Top-down every `down` voxels from the top, plus every floor of the ROI: material with
@@ -395,40 +418,50 @@ void PocketBuilder::report_what_stays() {
 }
 
 Toolpath& PocketBuilder::run(const Solid& roi, const Solid& keep, const Solid& stock, const Solid* design,
-                             const Solid* finish_region) {
+                             const Solid* finish_region, const Solid* laid) {
   lattice_ = roi.lattice();
   h_ = lattice_.voxel_size;
   model_ = make_tool(tool_, h_);
   use_step_sizes();
-  if (!take_material(roi, keep, stock)) return path_;
-  const IndexBox rb = remaining_.bounding_box();
+  const bool material = take_material(roi, keep, stock);
+  const Solid& region = finish_region ? *finish_region : roi;
+  const LaidWalls walls = laid && finishes_walls() ? laid_walls(*laid, region) : LaidWalls{};
+  if (!material && walls.levels.empty()) {
+    path_.warnings.push_back("nothing to remove: the region of influence holds no material");
+    return path_;
+  }
+  const IndexBox rb = geometry::box_union(remaining_.bounding_box(), walls.box);
   const int rc = int(std::ceil(model_.cutter_radius / h_));
   const int margin = 2 * rc + 4;
   work_ = {{rb.lo.x - margin, rb.lo.y - margin, rb.lo.z}, {rb.hi.x + margin, rb.hi.y + margin, all_.hi.z + 1}};
-  const Solid allowed = allowed_tips();
+  const Solid allowed = material ? allowed_tips() : Solid(lattice_, {});
   start_column_tops();
-  const Levels levels = cutting_levels();
-  level_heights_ = exact_heights(levels);
+  const Levels cutting = material ? cutting_levels() : Levels{};
+  level_heights_ = exact_heights(cutting);
+  Levels levels = cutting;
+  levels.insert(walls.levels.begin(), walls.levels.end());
   // The faces an action finishes are those next to what it may remove, also where an
   // earlier action left less than a voxel on them.
-  start_finishing(finish_region ? *finish_region : roi, design);
-  start_surface_finishing(finish_region ? *finish_region : roi, design);
+  start_finishing(region, design);
+  start_surface_finishing(region, design);
   int level_number = 0;
   int k_above = rb.hi.z;  // the ROI's layers [k, k_above) are level k's to remove
   double z_above = lattice_.origin.z + rb.hi.z * h_;
   for (const int k : levels) {
-    if (remaining_.empty()) break;
-    SliceMask usable = usable_tips(allowed, k);
-    if (drop_) usable = usable.without(under_surface(level_z(k)));
+    if (remaining_.empty() && !finishing_) break;
+    // Levels of the laid walls alone are finished, not roughed.
+    const bool roughed = cutting.count(k) > 0 && !remaining_.empty();
     std::optional<TipKeepOut> keep_out;
-    if (finishing_) {
+    if (finishing_) keep_out = keep_out_at(level_z(k));
+    if (roughed) {
+      SliceMask usable = usable_tips(allowed, k);
+      if (drop_) usable = usable.without(under_surface(level_z(k)));
       // The roughing keeps the cutter off the design's real surface, not only off the
       // voxel centres; the finishing passes take what that leaves.
-      keep_out = keep_out_at(level_z(k));
-      if (!keep_out->empty()) usable = usable.without(cells_in(keep_out->grown(rough_margin_)));
+      if (keep_out && !keep_out->empty()) usable = usable.without(cells_in(keep_out->grown(rough_margin_)));
+      const SliceMask useful = useful_tips(usable, k);
+      if (!useful.empty()) clear_level(useful, usable, k, ++level_number);
     }
-    const SliceMask useful = useful_tips(usable, k);
-    if (!useful.empty()) clear_level(useful, usable, k, ++level_number);
     if (keep_out) {
       finish_walls(*keep_out, k, k_above, level_z(k));
       // Walls that end at a face between this level and the one above, from that face.
@@ -438,6 +471,7 @@ Toolpath& PocketBuilder::run(const Solid& roi, const Solid& keep, const Solid& s
     k_above = k;
     z_above = level_z(k);
   }
+  if (finishing_) finish_walls_below(k_above, z_above);
   finish_surfaces();
   if (started_ && at_.z < safe_z_) move(MoveKind::Rapid, {at_.x, at_.y, safe_z_}, 0, false);
   report_what_stays();
@@ -479,8 +513,15 @@ Toolpath pocket_path(const geometry::Solid& roi_part, const geometry::Solid& kee
       throw std::invalid_argument("pocket_path: the finishing region is on another lattice than the ROI");
     finish_region = part_to_work(*options.finish_region, setup.approach);
   }
+  std::optional<Solid> laid;
+  if (design && options.laid && !options.laid->empty()) {
+    if (!(options.laid->lattice() == roi_part.lattice()))
+      throw std::invalid_argument("pocket_path: the laid material is on another lattice than the ROI");
+    laid = part_to_work(*options.laid, setup.approach);
+  }
   pocket::PocketBuilder builder(tool, options, path);
-  builder.run(roi, keep, stock, design ? &*design : nullptr, finish_region ? &*finish_region : nullptr);
+  builder.run(roi, keep, stock, design ? &*design : nullptr, finish_region ? &*finish_region : nullptr,
+              laid ? &*laid : nullptr);
   return path;
 }
 

@@ -79,6 +79,13 @@ struct PocketOptions {
   // leave to the exact surface: null makes them from `design` (centres inside it, as the
   // planner voxelizes).
   const geometry::Solid* design_voxels = nullptr;
+  // Material a deposit laid that no removal has finished since (part frame, on the
+  // solids' lattice), or null. With `design` and a flat cutter, the walls where it borders
+  // the finishing region are finished at every step-down of its height, also where the
+  // voxels hold nothing to remove: a bead stands past the design by up to its head's
+  // accuracy and the slack it is laid with, which no voxel shows (docs/toolpaths.md, "Wall
+  // finishing").
+  const geometry::Solid* laid = nullptr;
   // Wall finishing on (default) or off (the roughing alone, for comparison).
   bool finish_walls = true;
   // Surface finishing with ball and bull-nose cutters, given `design` (docs/toolpaths.md,

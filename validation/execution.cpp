@@ -247,6 +247,7 @@ class IncrementalRun {
     light.makes_gcode = made.makes_gcode;
     light.note = made.note;
     light.program = made.program;
+    light.laid = made.laid;  // where a resumed export goes on from
     actions_.push_back(std::move(light));
     if (made.makes_gcode) {
       made_.push_back(made.program);

@@ -169,11 +169,9 @@ TEST_F(WholePlan, TheBossPlateIsDepositedAndMilledForLessThanMillingItFromTheBlo
 
 // A repair (issue 16): the worn copy of the flanged hub (2.5 mm gone from half of the
 // flange's top) given as the stock. Every plan starts from it and deposits only what it
-// lacks; the best lays the missing region near-net and leaves it as deposited, and every
-// plan offered, run from the worn part on its own simulated controller, makes the hub
-// within tolerance both ways with no alarm. (Until stop 52 three more plans laid the region
-// near-net and then overfilled around it: the near-net beads now stand on the design's
-// real rim, past the voxels, and the overfill's first layers lie under them.)
+// lacks; the best lays the missing region near-net and leaves it as deposited, others
+// overfill it and mill it back, and every plan offered, run from the worn part on its own
+// simulated controller, makes the hub within tolerance both ways with no alarm.
 TEST_F(WholePlan, AWornHubIsRepairedByDepositingOnlyWhatItLacksAndEveryPlanRunsWithinTolerance) {
   const std::string source = HYBRIDCTL_SOURCE_DIR;
   // At 0.7 mm: the repaired faces stay as deposited, within the powder head's 0.25 mm of
@@ -185,17 +183,26 @@ TEST_F(WholePlan, AWornHubIsRepairedByDepositingOnlyWhatItLacksAndEveryPlanRunsW
   ASSERT_TRUE(std::regex_search(r.out, ran, std::regex("dry-run     ([0-9]+) of \\1 plans ran to the end with no alarm, "
                                                        "within tolerance both ways")))
       << r.out;
-  EXPECT_GE(std::stoi(ran[1]), 2);
-  // "  1. (P1 ∪ P16)": the stock and the near-net deposit near the missing region.
-  const std::regex local("\\n  (P[0-9]+) +U-AM ded from \\+Z \\(top\\), near the missing 2454 mm");
-  std::smatch m;
-  ASSERT_TRUE(std::regex_search(r.out, m, local)) << r.out;
-  EXPECT_NE(r.out.find("\n  1. (P1 ∪ " + std::string(m[1]) + ")  cost"), std::string::npos) << r.out;
+  EXPECT_GE(std::stoi(ran[1]), 3);
+  // "  1. (P1 ∪ P2)": the stock and a near-net deposit from the top, which lays only what
+  // the stock lacks (the whole design's U-AM or the one near the missing region).
+  std::smatch best;
+  ASSERT_TRUE(std::regex_search(r.out, best, std::regex("\\n  1\\. \\(P1 ∪ (P[0-9]+)\\)  cost"))) << r.out;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("\\n  " + std::string(best[1]) + " +U-AM ded from \\+Z \\(top\\)")))
+      << r.out;
+  // The repair shops plan by hand: overfill near the missing region, then mill it back.
+  // Its beads stand past the flange's rim under the voxels the removal meets; the rim is
+  // finished down to them (docs/toolpaths.md, "Wall finishing").
+  std::smatch overfill;
+  ASSERT_TRUE(std::regex_search(r.out, overfill, std::regex("\\n  (P[0-9]+) +O-AM ded from \\+Z \\(top\\), near the missing 2454 mm")))
+      << r.out;
+  EXPECT_TRUE(std::regex_search(r.out, std::regex("\\n  [0-9]\\. \\(\\(P1 ∪ " + std::string(overfill[1]) + "\\) − P[0-9]+\\)  cost")))
+      << r.out;
   // Every action after the stock deposits at most the missing 2,454 mm³ and its overfill.
   const std::regex deposit("\\n     [0-9]\\) P[0-9]+ +[UO]-AM [^\\n]* deposit +([0-9.]+) mm");
   int deposits = 0;
   for (auto it = std::sregex_iterator(r.out.begin(), r.out.end(), deposit); it != std::sregex_iterator(); ++it, ++deposits)
-    EXPECT_LT(std::stod((*it)[1]), 2454 * 1.2) << it->str();
+    EXPECT_LT(std::stod((*it)[1]), 2454 * 1.4) << it->str();
   EXPECT_GE(deposits, 2);
 }
 

@@ -608,6 +608,89 @@ TEST(PocketPath, WallFinishingKeepsOffWhatStaysThatIsNotDesign) {
   }
 }
 
+// A block standing off the lattice (its walls between voxel centres), with all round it
+// the region a removal may take, and the options that finish its walls from the STL.
+struct BlockInAir {
+  Box3 block{{6.2, 6.1, 0}, {15.9, 15.8, 8}};
+  std::shared_ptr<const std::vector<Triangle>> mesh =
+      std::make_shared<const std::vector<Triangle>>(prism_mesh(rectangle_xy(block), 0, 8));
+  Solid design = geometry::voxelize(geometry::TriangleMesh{*mesh}, kLattice, "block");
+  Solid region = geometry::subtract(box({{0, 0, 0}, {22, 22, 10}}), design);
+  PocketOptions finishing() const {
+    PocketOptions o;
+    o.design = mesh;
+    o.design_voxels = &design;
+    o.finish_region = &region;
+    return o;
+  }
+  // Signed distance from the block's outline in XY (negative inside).
+  double off_block(double x, double y) const { return distance_to_polygon(x, y, rectangle_xy(block)); }
+};
+
+TEST(PocketPath, WallFinishingRunsOnUnderTheLowestLevelWhereABeadsSpillMayStand) {
+  // A deposit's overfill round the top of a block: its voxels start at z = 5, its beads
+  // (laid at their own layer heights) may reach lower. The region the action may remove is
+  // all round the block, so its walls are finished on down a material allowance (1 mm)
+  // under the lowest level, and no lower.
+  const BlockInAir b;
+  const Solid overfill = geometry::subtract(box({{4, 4, 5}, {18, 18, 8}}), b.design);
+  const Solid stock = geometry::unite(b.design, overfill);
+  const auto tool = flat_4mm();
+  const double r = tool.diameter / 2;
+  const Toolpath p = pocket_path(overfill, b.design, stock, tool, top_setup(), b.finishing());
+  const Replay rp = replay(p, stock, b.design, tool);
+  EXPECT_EQ(rp.gouges, 0);
+  EXPECT_EQ(rp.rapids_into_material, 0);
+  EXPECT_EQ(rp.plunges_into_material, 0);
+  double lowest = 1e300;
+  for (const auto& pass : finishing_passes(p))
+    for (const Vec3& q : pass) lowest = std::min(lowest, q.z);
+  // The lowest level is the overfill's bottom layer (tip at its centre, 5.25): passes at
+  // the centres of the two layers under it, 4.75 and 4.25.
+  EXPECT_NEAR(lowest, 4.25, 1e-9);
+  auto off_block = [&](double x, double y) { return b.off_block(x, y); };
+  EXPECT_GE(closest_approach(p, off_block, 4, 8), r + 0.0002 - 1e-9) << "never into the block";
+  EXPECT_LE(closest_approach(p, off_block, 4.2, 4.3, true), r + 0.0012 + 1e-9) << "on its walls down there";
+}
+
+TEST(PocketPath, TheWallsADepositLaidAreFinishedWhereNoVoxelIsLeftToRemove) {
+  // A block laid near-net from z = 3 up: on the voxels nothing stands outside it, but its
+  // beads stand past the STL by up to the head's accuracy. A removal whose region is all
+  // round it finishes those walls at every step-down of the laid height, and down a
+  // material allowance (1 mm) under it; with nothing laid it has nothing to do.
+  const BlockInAir b;
+  const Solid laid = geometry::intersect(b.design, box({{0, 0, 3}, {22, 22, 8}}));
+  const Solid nothing(kLattice, {});
+  const auto tool = flat_4mm();
+  const double r = tool.diameter / 2;
+  PocketOptions o = b.finishing();
+  const Toolpath idle = pocket_path(nothing, b.design, b.design, tool, top_setup(), o);
+  EXPECT_TRUE(idle.moves.empty());
+  ASSERT_FALSE(idle.warnings.empty());
+  EXPECT_NE(idle.warnings.front().find("nothing to remove"), std::string::npos) << idle.warnings.front();
+  o.laid = &laid;
+  const Toolpath p = pocket_path(nothing, b.design, b.design, tool, top_setup(), o);
+  EXPECT_TRUE(p.defects.empty());
+  const Replay rp = replay(p, b.design, b.design, tool);
+  EXPECT_EQ(rp.gouges, 0);
+  EXPECT_EQ(rp.rapids_into_material, 0);
+  EXPECT_EQ(rp.plunges_into_material, 0);
+  std::set<double> heights;
+  for (const auto& pass : finishing_passes(p))
+    for (const Vec3& q : pass) heights.insert(q.z);
+  ASSERT_FALSE(heights.empty());
+  // From the top laid layer's centre (7.75) down, a step-down (the tool's 2 mm) apart at
+  // most, to the lowest laid layer's centre (3.25) and the two under it (2.75, 2.25).
+  EXPECT_NEAR(*heights.rbegin(), 7.75, 1e-9);
+  EXPECT_NEAR(*heights.begin(), 2.25, 1e-9);
+  for (auto it = std::next(heights.begin()); it != heights.end(); ++it)
+    EXPECT_LE(*it - *std::prev(it), tool.step_down + 1e-9) << "between " << *std::prev(it) << " and " << *it;
+  auto off_block = [&](double x, double y) { return b.off_block(x, y); };
+  EXPECT_GE(closest_approach(p, off_block, 0, 10), r + 0.0002 - 1e-9) << "never into the block";
+  for (const double z : heights)
+    EXPECT_LE(closest_approach(p, off_block, z - 0.01, z + 0.01, true), r + 0.0012 + 1e-9) << "on its walls at z = " << z;
+}
+
 TEST(PocketPath, NothingToRemoveGivesAnEmptyPathWithAWarning) {
   const Solid stock = box({{0, 0, 0}, {10, 10, 5}});
   const Toolpath p = pocket_path(Solid(kLattice, {}), stock, stock, flat_4mm(), top_setup());
