@@ -86,6 +86,9 @@ class PocketBuilder {
     IndexBox box;
   };
   LaidWalls laid_walls(const Solid& laid, const Solid& region) const;
+  // The tops of laid material under a floor of the design, to skim at the floor's height:
+  // per level, the cells (tip domain); sets those levels' heights.
+  std::map<int, SliceMask> laid_floors(const Solid& laid, const Solid& region);
   void held_rows(int y, int z, std::vector<std::uint64_t>& held) const;
   SliceMask usable_tips(const Solid& allowed, int k) const;
   SliceMask useful_tips(const SliceMask& usable, int k) const;

@@ -267,6 +267,30 @@ PocketBuilder::LaidWalls PocketBuilder::laid_walls(const Solid& laid, const Soli
   return out;
 }
 
+// The tops of laid material under a floor of the design the tool faces (the region over
+// them): per level, the layer above them with its tip at the floor's height (set in
+// level_heights_ where no cutting level has one), the cells to skim. A bead stands above
+// the floor by up to its head's accuracy, which no voxel shows.
+std::map<int, SliceMask> PocketBuilder::laid_floors(const Solid& laid, const Solid& region) {
+  std::map<int, SliceMask> out;
+  const IndexBox b = geometry::box_intersection(laid.bounding_box(), {{work_.lo.x, work_.lo.y, laid.bounding_box().lo.z},
+                                                                      {work_.hi.x, work_.hi.y, laid.bounding_box().hi.z}});
+  for (int k = b.lo.z; k < b.hi.z; ++k) {
+    SliceMask top = slice_of(laid, k, work_);
+    if (top.empty()) continue;
+    top &= slice_of(region, k + 1, work_);
+    if (top.empty()) continue;
+    const double c = centre_z(k + 1);
+    double floor = -kInf;
+    for (const geometry::Triangle& f : options_.floors)
+      if (f[0].z > c - h_ + 1e-6 && f[0].z <= c + 1e-9) floor = std::max(floor, f[0].z);
+    if (std::isinf(floor)) continue;
+    level_heights_.emplace(k + 1, floor);
+    out.emplace(k + 1, std::move(top));
+  }
+  return out;
+}
+
 // Top-down every `down` voxels from the top, plus every floor of the ROI: material with
 // something that must remain under it before the next level down (a step-down at most),
 // where the tip cannot go lower. Material over air needs no level of its own: the next
@@ -434,12 +458,14 @@ Toolpath& PocketBuilder::run(const Solid& roi, const Solid& keep, const Solid& s
   const int rc = int(std::ceil(model_.cutter_radius / h_));
   const int margin = 2 * rc + 4;
   work_ = {{rb.lo.x - margin, rb.lo.y - margin, rb.lo.z}, {rb.hi.x + margin, rb.hi.y + margin, all_.hi.z + 1}};
-  const Solid allowed = material ? allowed_tips() : Solid(lattice_, {});
   start_column_tops();
   const Levels cutting = material ? cutting_levels() : Levels{};
   level_heights_ = exact_heights(cutting);
+  const std::map<int, SliceMask> skims = laid && finishes_walls() ? laid_floors(*laid, region) : std::map<int, SliceMask>{};
+  const Solid allowed = material || !skims.empty() ? allowed_tips() : Solid(lattice_, {});
   Levels levels = cutting;
   levels.insert(walls.levels.begin(), walls.levels.end());
+  for (const auto& [k, cells] : skims) levels.insert(k);
   // The faces an action finishes are those next to what it may remove, also where an
   // earlier action left less than a voxel on them.
   start_finishing(region, design);
@@ -449,17 +475,24 @@ Toolpath& PocketBuilder::run(const Solid& roi, const Solid& keep, const Solid& s
   double z_above = lattice_.origin.z + rb.hi.z * h_;
   for (const int k : levels) {
     if (remaining_.empty() && !finishing_) break;
-    // Levels of the laid walls alone are finished, not roughed.
+    // Levels of the laid walls alone are finished, not roughed; the tops of laid material
+    // under a floor are skimmed at the floor's height.
     const bool roughed = cutting.count(k) > 0 && !remaining_.empty();
+    const auto skim = skims.find(k);
     std::optional<TipKeepOut> keep_out;
     if (finishing_) keep_out = keep_out_at(level_z(k));
-    if (roughed) {
+    if (roughed || skim != skims.end()) {
       SliceMask usable = usable_tips(allowed, k);
       if (drop_) usable = usable.without(under_surface(level_z(k)));
       // The roughing keeps the cutter off the design's real surface, not only off the
       // voxel centres; the finishing passes take what that leaves.
       if (keep_out && !keep_out->empty()) usable = usable.without(cells_in(keep_out->grown(rough_margin_)));
-      const SliceMask useful = useful_tips(usable, k);
+      SliceMask useful = roughed ? useful_tips(usable, k) : usable.without(usable);
+      if (skim != skims.end()) {
+        SliceMask over = grow_by_disc(skim->second, model_.cutter_radius / h_);
+        over &= usable;
+        useful |= over;
+      }
       if (!useful.empty()) clear_level(useful, usable, k, ++level_number);
     }
     if (keep_out) {

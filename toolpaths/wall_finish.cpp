@@ -281,11 +281,9 @@ TipKeepOut TipKeepOut::grown(double by, double chord_tolerance) const {
 TipKeepOut tip_keep_out(const std::vector<Triangle>& design, double tip_z, const std::vector<ToolBand>& bands,
                         const WallFinishOptions& options) {
   Paths all;
-  bool first = true;
   for (const ToolBand& b : bands) {
-    const double lo = tip_z + (first ? std::max(b.from, options.floor_slack) : b.from);
+    const double lo = tip_z + b.from + options.floor_slack;
     const double hi = tip_z + b.to;
-    first = false;
     if (!(hi >= lo) || !(b.radius >= 0)) continue;
     const Paths s = shadow(design, lo, hi);
     if (s.empty()) continue;

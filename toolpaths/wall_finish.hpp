@@ -19,8 +19,10 @@
 // coordinates of 10 nm); the union over the bands is the keep-out region. A point outside
 // it puts no part of the tool into the design: a vertical facet inside a slab is covered
 // by the facet under it or by the cross-section (go down the facet until either). The
-// lowest band starts `floor_slack` above the tip: a face at the tip's own height is a
-// floor the flat bottom stands on, not a wall.
+// bands start `floor_slack` above their bottoms: a face at the tip's own height is a
+// floor the flat bottom stands on, not a wall, and a face at the height where a wider
+// section begins (the top of a wall as tall as the flutes, under the shank) is touched,
+// not entered (the band below holds it).
 //
 // Accuracy: each band is offset by r_i + chord_tolerance + clearance, and a round join's
 // chords lie at most chord_tolerance inside its arc, so every point of a loop is between
@@ -49,7 +51,7 @@ struct WallFinishOptions {
   double chord_tolerance = 0.001;
   // Added to every band's radius (mm): the least stand-off from the design.
   double clearance = 0.0002;
-  // The lowest band starts this far (mm) above the tip.
+  // Every band starts this far (mm) above its bottom.
   double floor_slack = 0.0001;
 };
 

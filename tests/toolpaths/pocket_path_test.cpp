@@ -689,6 +689,20 @@ TEST(PocketPath, TheWallsADepositLaidAreFinishedWhereNoVoxelIsLeftToRemove) {
   EXPECT_GE(closest_approach(p, off_block, 0, 10), r + 0.0002 - 1e-9) << "never into the block";
   for (const double z : heights)
     EXPECT_LE(closest_approach(p, off_block, z - 0.01, z + 0.01, true), r + 0.0012 + 1e-9) << "on its walls at z = " << z;
+  // Given the block's top as a floor the tool faces, the top is skimmed at its height too
+  // (a bead's top stands above it): feed moves at z = 8 over the middle of the block.
+  for (const Triangle& t : *b.mesh)
+    if (t[0].z == 8 && t[1].z == 8 && t[2].z == 8) o.floors.push_back(t);
+  ASSERT_FALSE(o.floors.empty());
+  const Toolpath skimmed = pocket_path(nothing, b.design, b.design, tool, top_setup(), o);
+  const Replay rs = replay(skimmed, b.design, b.design, tool);
+  EXPECT_EQ(rs.gouges, 0);
+  EXPECT_EQ(rs.plunges_into_material, 0);
+  // The deepest a feed move at z = 8 comes inside the block's outline (mm, negative inside).
+  const double no_skim = closest_approach(p, off_block, 8 - 1e-6, 8 + 1e-6, true);
+  const double skim = closest_approach(skimmed, off_block, 8 - 1e-6, 8 + 1e-6, true);
+  EXPECT_GT(no_skim, 0) << "no floor given, no skim";
+  EXPECT_LT(skim, -4) << "rows across the top";
 }
 
 TEST(PocketPath, NothingToRemoveGivesAnEmptyPathWithAWarning) {

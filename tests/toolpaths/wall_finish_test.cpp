@@ -330,6 +330,21 @@ TEST(WallFinish, AHolderWiderThanTheCutterKeepsOffATallWall) {
   along_loop(high.loops()[0], [&](Point2 p) { expect_stand_off(distance_to(p, gon), r, p); });
 }
 
+TEST(WallFinish, AWallAsTallAsTheFlutesIsTouchedNotEnteredByTheWiderShank) {
+  // A 10 mm wall above the tip, flutes 10 mm, then a shank of r = 3: at the wall's foot the
+  // shank's bottom stands on the wall's top edge and the cutter reaches the whole wall.
+  const double r = 2;
+  const std::vector<Point2> rect = rectangle(0, 0, 30, 2.5);
+  const std::vector<ToolBand> tool{{0, 10, r}, {10, 50, 3}, {50, kInf, 20}};
+  const TipKeepOut foot = tip_keep_out(prism(rect, 2, 12), 2, tool, kOptions);
+  ASSERT_EQ(foot.loops().size(), 1u);
+  along_loop(foot.loops()[0], [&](Point2 p) { expect_stand_off(distance_to(p, rect), r, p); });
+  // A hair lower, the shank would enter the wall's top: it keeps the shank's radius off.
+  const TipKeepOut lower = tip_keep_out(prism(rect, 0, 12), 1.99, tool, kOptions);
+  ASSERT_EQ(lower.loops().size(), 1u);
+  along_loop(lower.loops()[0], [&](Point2 p) { expect_stand_off(distance_to(p, rect), 3, p); });
+}
+
 TEST(WallFinish, NothingAboveTheTipGivesNoLoops) {
   const TipKeepOut f = tip_keep_out(prism(rectangle(0, 0, 10, 10), 0, 10), 10, flat(2, 8), kOptions);
   EXPECT_TRUE(f.empty()) << "the tip on the top face: nothing to keep out of";
