@@ -22,6 +22,12 @@ double bead_half_width_at(const Bead& bead, double dz) {
   return r * std::sqrt(std::max(0.0, 1 - u * u));
 }
 
+double bead_top_dip(const Bead& bead, double spacing) {
+  if (bead.shape != config::BeadShape::Ellipsoid || !(bead.width > 0)) return 0;
+  const double u = std::min(1.0, spacing / bead.width);
+  return bead.height / 2 * (1 - std::sqrt(1 - u * u));
+}
+
 int head_tool_number(const config::AdditiveHead& head, int fallback) {
   return head.tool_number > 0 ? head.tool_number : fallback;
 }

@@ -42,6 +42,10 @@ Bead bead_of(const config::AdditiveHead& head);
 // sideways, and no farther.
 double bead_half_width_at(const Bead& bead, double dz);
 
+// How far under the crests (mm) two tracks laid side by side `spacing` apart meet on top:
+// an ellipsoid track's top is the upper half of its ellipse, a cylinder's is flat (0).
+double bead_top_dip(const Bead& bead, double spacing);
+
 // The T number that selects a head: its tool_number when positive (the machine loader
 // always sets one), otherwise `fallback`.
 int head_tool_number(const config::AdditiveHead& head, int fallback);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <optional>
@@ -228,6 +227,7 @@ class DepositionBuilder {
   // Parameters, mm.
   double lh_ = 0, s_ = 0, w_ = 0, travel_ = 0, inset_ = 0, min_length_ = 0, support_gap_ = 0, reach_ = 0, gap_ = 0,
          corridor_ = 0, plate_z_ = 0, z0_ = 0, z_top_ = 0, safe_z_ = 0;
+  double top_drop_ = 0;  // mm a near-net deposit's last layer is laid under its band
   std::vector<double> angles_;
   instruments::Bead bead_;
   // Emission state.
@@ -304,9 +304,12 @@ void DepositionBuilder::start_columns(const Solid& existing, const IndexBox& roi
 
   z0_ = face(roi_box.lo.z), z_top_ = face(roi_box.hi.z);
   // A near-net deposit's layers end on its top: as many as the head's layer height needs,
-  // a little thinner each, so the last bead's top stands over the top face by the beads'
-  // overlap, not by most of a layer more.
-  if (options_.near_net_design && z_top_ > z0_) lh_ = (z_top_ - z0_) / std::ceil((z_top_ - z0_) / lh_ - 1e-9);
+  // a little thinner each, and the last laid lower, so that its crests stand over the top
+  // by half the dip where two tracks meet, not by the beads' overlap or most of a layer.
+  if (options_.near_net_design && z_top_ > z0_) {
+    lh_ = (z_top_ - z0_) / std::ceil((z_top_ - z0_) / lh_ - 1e-9);
+    top_drop_ = std::max(0.0, head_.bead.height - lh_ - instruments::bead_top_dip(bead_, s_) / 2);
+  }
   safe_z_ = std::max({highest_existing, z_top_, z0_ + std::ceil((z_top_ - z0_) / lh_) * lh_}) +
             std::max(head_.bead.height, 0.0) + travel_;
   path_.safe_z = safe_z_;
@@ -597,17 +600,18 @@ void DepositionBuilder::keep_pieces_within(const TipKeepOut& inside, std::vector
 }
 
 void DepositionBuilder::deposit_layer(int layer, double zb) {
+  // The height the layer is laid at: its band's bottom, lower for a near-net deposit's last.
+  const double zp = zb + lh_ >= z_top_ - 1e-9 ? zb - top_drop_ : zb;
   int k = 0;
   SliceMask region = layer_region(roi_, zb, k);
   if (region.empty()) return;
   drop_blocked(region, k, layer, zb);
-  if (region.empty()) return;
-  drop_overhangs(region, layer, zb);
+  if (!region.empty()) drop_overhangs(region, layer, zb);
   if (region.empty()) return;
   // This layer's beads count at their full height for travels from its first pass on.
   for (int y = window_.lo.y; y < window_.hi.y; ++y)
     for (int x = window_.lo.x; x < window_.hi.x; ++x)
-      if (region.at(x, y)) travel_top_.ref(x, y) = std::max(travel_top_.at(x, y), zb + head_.bead.height);
+      if (region.at(x, y)) travel_top_.ref(x, y) = std::max(travel_top_.at(x, y), zp + head_.bead.height);
 
   const double angle = angles_[std::size_t(layer) % angles_.size()];
   bool first_of_layer = true;
@@ -621,16 +625,16 @@ void DepositionBuilder::deposit_layer(int layer, double zb) {
   const SliceMask counted_here = check_body ? layer_region(*counted_, zb, counted_top) : empty_mask_;
   const std::optional<TipKeepOut> within = near_net_region(zb);
   for (const Pass& p : passes_of(region, wall, layer, angle, zb, within ? &*within : nullptr)) {
-    if (check_body && !touches(p, counted_here) && body_meets_material(p, zb)) {
+    if (check_body && !touches(p, counted_here) && body_meets_material(p, zp)) {
       ++body_skipped_;
       continue;
     }
-    travel_to(p.points.front(), zb);
+    travel_to(p.points.front(), zp);
     for (std::size_t i = 1; i < p.points.size(); ++i) {
       std::string comment;
-      if (first_of_layer) comment = "layer " + std::to_string(layer + 1) + " z=" + mm(zb) + " raster " + mm(angle) + " deg";
+      if (first_of_layer) comment = "layer " + std::to_string(layer + 1) + " z=" + mm(zp) + " raster " + mm(angle) + " deg";
       first_of_layer = false;
-      move(MoveKind::Feed, {p.points[i].x, p.points[i].y, zb}, head_.feed, true, std::move(comment));
+      move(MoveKind::Feed, {p.points[i].x, p.points[i].y, zp}, head_.feed, true, std::move(comment));
     }
   }
   // The layer is down: layer_height of material on its region, as far as its beads reach

@@ -257,7 +257,7 @@ TEST(DepositionPath, ANearNetDepositLaysBothFacesOfABladeAcrossTheGrid) {
 
 // The head's 0.6 mm layers over a wall 2 mm tall: 0.6, 1.2, 1.8, and the last bead's top
 // 0.55 mm over the wall. A near-net deposit takes four layers of 0.5 mm instead, the last
-// one ending on the top: its bead stands over it by the beads' overlap alone.
+// one laid so that its crests stand just over the top.
 TEST(DepositionPath, ANearNetDepositsLayersEndOnItsTop) {
   const geometry::TriangleMesh wall = geometry::testing::box_mesh({2.25, 2.25, 0}, {14.75, 6.75, 2});
   const Solid roi = make_box(kLattice, {{2, 2, 0}, {15, 7, 2}});
@@ -266,7 +266,15 @@ TEST(DepositionPath, ANearNetDepositsLayersEndOnItsTop) {
   const Toolpath p = deposition_path(roi, Solid(kLattice, {}), ded_head(), top_setup(), near_net);
   std::set<double> heights;
   for (const Segment& s : deposition_segments(p)) heights.insert(std::round(s.a.z * 1e6) / 1e6);
-  EXPECT_EQ(std::vector<double>(heights.begin(), heights.end()), (std::vector<double>{0, 0.5, 1.0, 1.5}));
+  // Four layers of 0.5 mm instead of 0.6; the last is laid lower, so that its tracks'
+  // crests (0.75 mm over it) stand over the top by half the dip where two tracks a hatch
+  // apart meet (an ellipse 1.5 wide, 0.375 over its middle, at 0.525 mm off its axis), not
+  // by the beads' overlap (0.25 mm).
+  const double dip = 0.375 * (1 - std::sqrt(1 - 0.7 * 0.7));
+  const std::vector<double> z(heights.begin(), heights.end());
+  ASSERT_EQ(z.size(), 4u);
+  EXPECT_EQ(std::vector<double>(z.begin(), z.begin() + 3), (std::vector<double>{0, 0.5, 1.0}));
+  EXPECT_NEAR(z[3] + 0.75, 2 + dip / 2, 1e-6);
 }
 
 TEST(DepositionPath, LayersGoBottomUpAtTheLayerHeight) {
