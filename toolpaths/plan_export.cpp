@@ -295,18 +295,20 @@ ExportedAction export_planned_action(const plan::PlanFile& file, const plan::Pla
     throw std::invalid_argument("export_planned_action: no action " + std::to_string(k) + " or not the plan's states");
   check_machine(file, machine);
   DesignFrames design(file.design_mesh);
+  const auto primitive = [&](int j) -> const plan::PlanFilePrimitive& {
+    return file.primitives.at(std::size_t(plan.actions[std::size_t(j)].primitive));
+  };
+  // What the actions before it laid, from their regions of influence in the planned states.
   geometry::Solid laid(file.lattice, {});
   for (int j = 0; j < k; ++j) {
-    const plan::PlanFilePrimitive& p = file.primitives.at(std::size_t(plan.actions[std::size_t(j)].primitive));
-    ExportedAction a;
-    a.roi = p.mode == config::Mode::Additive ? subtract(p.region, planned[std::size_t(j)])
-                                             : intersect(planned[std::size_t(j)], p.region);
-    laid = laid_after(std::move(laid), p, a, finishes_walls(p, machine, options));
+    ExportedAction before;
+    before.roi = primitive(j).mode == config::Mode::Additive ? subtract(primitive(j).region, planned[std::size_t(j)])
+                                                             : intersect(planned[std::size_t(j)], primitive(j).region);
+    laid = laid_after(std::move(laid), primitive(j), before, finishes_walls(primitive(j), machine, options));
   }
   ExportedAction a = make_action(k, planned[std::size_t(k)], &planned[std::size_t(k) + 1],
                                  plan::simulated_domain(file, plan, machine), file, plan, machine, options, design, laid);
-  a.laid = laid_after(std::move(laid), file.primitives.at(std::size_t(plan.actions[std::size_t(k)].primitive)), a,
-                      finishes_walls(file.primitives.at(std::size_t(plan.actions[std::size_t(k)].primitive)), machine, options));
+  a.laid = laid_after(std::move(laid), primitive(k), a, finishes_walls(primitive(k), machine, options));
   return a;
 }
 
