@@ -17,8 +17,10 @@
 // Entries plunge only where the tool meets no material on the way down; elsewhere they
 // lead in sideways from air, or ramp along the first segment at ramp_angle_deg.
 // Given the design's STL (PocketOptions::design), a flat cutter then follows the design's
-// real walls at each level (wall finishing), off the lattice; a ball or bull nose finishes
-// the faces under the region by a drop-cutter raster on the STL (surface finishing).
+// real walls at each level (wall finishing), off the lattice, and finishes the walls and
+// tops of what deposits laid (PocketOptions::laid) where the voxels show nothing to remove;
+// a ball or bull nose finishes the faces under the region by a drop-cutter raster on the
+// STL (surface finishing).
 
 #include <memory>
 #include <optional>
