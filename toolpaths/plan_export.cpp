@@ -215,7 +215,12 @@ geometry::Solid laid_after(geometry::Solid laid, const plan::PlanFilePrimitive& 
   if (p.mode == config::Mode::Additive) return geometry::unite(laid, a.roi);
   if (laid.empty()) return laid;
   laid = geometry::subtract(laid, a.roi);
-  if (finishes) laid = geometry::subtract(laid, geometry::dilate(p.region, geometry::Ball{1.5 * p.region.lattice().voxel_size}));
+  if (finishes) {
+    // Only round what was laid: the region may span the whole domain.
+    const geometry::IndexBox b = laid.bounding_box();
+    const geometry::IndexBox near{{b.lo.x - 2, b.lo.y - 2, b.lo.z - 2}, {b.hi.x + 2, b.hi.y + 2, b.hi.z + 2}};
+    laid = geometry::subtract(laid, geometry::dilate(p.region, geometry::Ball{1.5 * p.region.lattice().voxel_size}, near));
+  }
   return laid;
 }
 

@@ -102,6 +102,7 @@ class PocketBuilder {
     return it == level_heights_.end() ? centre_z(k) : it->second;
   }
   std::map<int, double> exact_heights(const Levels& levels) const;
+  double floor_height(int k) const;
   Vec3 at_cell(Cell c, double z) const {
     return {lattice_.origin.x + (c.x + 0.5) * h_, lattice_.origin.y + (c.y + 0.5) * h_, z};
   }

@@ -280,10 +280,7 @@ std::map<int, SliceMask> PocketBuilder::laid_floors(const Solid& laid, const Sol
     if (top.empty()) continue;
     top &= slice_of(region, k + 1, work_);
     if (top.empty()) continue;
-    const double c = centre_z(k + 1);
-    double floor = -kInf;
-    for (const geometry::Triangle& f : options_.floors)
-      if (f[0].z > c - h_ + 1e-6 && f[0].z <= c + 1e-9) floor = std::max(floor, f[0].z);
+    const double floor = floor_height(k + 1);
     if (std::isinf(floor)) continue;
     level_heights_.emplace(k + 1, floor);
     out.emplace(k + 1, std::move(top));
@@ -320,6 +317,16 @@ PocketBuilder::Levels PocketBuilder::cutting_levels() const {
   return levels;
 }
 
+// The highest of the design's floors in (centre - h, centre] of layer k's voxels, where a
+// flat cutter's tip at level k takes the same voxels; -infinity when none.
+double PocketBuilder::floor_height(int k) const {
+  const double c = centre_z(k);
+  double z = -kInf;
+  for (const geometry::Triangle& f : options_.floors)
+    if (f[0].z > c - h_ + 1e-6 && f[0].z <= c + 1e-9) z = std::max(z, f[0].z);
+  return z;
+}
+
 // A flat cutter's tip anywhere in (centre - h, centre] of level k's voxels takes the same
 // voxels (none below: their centres lie under its flat bottom), so it goes to where the
 // part's face is: the highest floor of the design in that range, or, with nothing to keep
@@ -331,9 +338,7 @@ std::map<int, double> PocketBuilder::exact_heights(const Levels& levels) const {
   constexpr double kSlack = 1e-9;  // mm
   for (const int k : levels) {
     const double c = centre_z(k);
-    double z = -kInf;
-    for (const geometry::Triangle& f : options_.floors)
-      if (f[0].z > c - h_ + 1e-6 && f[0].z <= c + kSlack) z = std::max(z, f[0].z);
+    double z = floor_height(k);
     if (std::isinf(z) && (k - 1 < untouchable_.storage_box().lo.z || k - 1 >= untouchable_.storage_box().hi.z ||
                           slice_of(untouchable_, k - 1, work_).empty()))
       z = c - h_ / 2;
