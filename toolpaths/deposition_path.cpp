@@ -194,8 +194,7 @@ class DepositionBuilder {
   // DepositionOptions::near_net_design: where the layer's bead axes may go, and the passes
   // kept there.
   std::optional<TipKeepOut> near_net_region(double zb) const;
-  // Its contour's axes: the design's sections at the band's voxel centres, the heights its
-  // region stands for (a band over a flat face holds the part above or below it only).
+  // Its contour's axes: the design's sections at near_net_section_heights.
   TipKeepOut near_net_contour_axes(double zb) const;
   void keep_within(const TipKeepOut& inside, std::vector<Pass>& contour, std::vector<Pass>& rasters) const;
   void keep_pieces_within(const TipKeepOut& inside, std::vector<Pass>& rasters) const;
@@ -565,11 +564,9 @@ std::optional<TipKeepOut> DepositionBuilder::near_net_region(double zb) const {
 }
 
 TipKeepOut DepositionBuilder::near_net_contour_axes(double zb) const {
-  std::vector<double> heights;
-  const int k_lo = int(std::ceil((zb - oz_) / h_ - 0.5 - 1e-9)), k_hi = int(std::ceil((zb + lh_ - oz_) / h_ - 0.5 - 1e-9)) - 1;
-  for (int k = k_lo; k <= k_hi; ++k) heights.push_back(oz_ + (k + 0.5) * h_);
-  if (heights.empty()) heights.push_back(zb + lh_ / 2);
-  return section_shrunk(*options_.near_net_design, heights, w_ / 2 - std::max(0.0, options_.near_net_slack));
+  return section_shrunk(*options_.near_net_design,
+                        near_net_section_heights(*options_.near_net_design, zb, lh_, head_.bead.height, lattice_),
+                        w_ / 2 - std::max(0.0, options_.near_net_slack));
 }
 
 void DepositionBuilder::keep_within(const TipKeepOut& inside, std::vector<Pass>& contour, std::vector<Pass>& rasters) const {

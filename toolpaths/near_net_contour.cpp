@@ -185,4 +185,21 @@ std::vector<std::vector<Point2>> near_net_gap_loops(const TipKeepOut& axes, cons
                  lattice, bead.min_length, nullptr);
 }
 
+std::vector<double> near_net_section_heights(const std::vector<geometry::Triangle>& design, double zb,
+                                             double layer_height, double bead_height, const geometry::Lattice& lattice) {
+  constexpr double kFlat = 1e-9;  // mm: a facet whose corners differ less in z is flat
+  const double top = zb + layer_height;
+  const bool flat_face_within = std::any_of(design.begin(), design.end(), [&](const geometry::Triangle& t) {
+    const double z = t[0].z;
+    return std::abs(t[1].z - z) < kFlat && std::abs(t[2].z - z) < kFlat && z > zb + kFlat && z < top - kFlat;
+  });
+  if (!flat_face_within) return {zb + std::min(layer_height, bead_height / 2) / 2};
+  const double h = lattice.voxel_size, oz = lattice.origin.z;
+  std::vector<double> heights;
+  const int k_lo = int(std::ceil((zb - oz) / h - 0.5 - 1e-9)), k_hi = int(std::ceil((top - oz) / h - 0.5 - 1e-9)) - 1;
+  for (int k = k_lo; k <= k_hi; ++k) heights.push_back(oz + (k + 0.5) * h);
+  if (heights.empty()) heights.push_back(zb + layer_height / 2);
+  return heights;
+}
+
 }  // namespace hybridctl::toolpaths

@@ -63,6 +63,15 @@ std::vector<std::vector<Point2>> near_net_gap_loops(const TipKeepOut& axes, cons
                                                     const geometry::Lattice& lattice, const NearNetBead& bead,
                                                     double hatch_spacing);
 
+// The heights (mm) whose sections a near-net layer's contour follows, the layer laid at
+// `zb` (the bead's bottom) `layer_height` thick: the middle of the height over which the
+// bead is full width (instruments/bead.hpp), so that on a sloped face the layer's
+// staircase straddles the face rather than standing out of it by a layer's step. Where a
+// flat face of `design` lies within the layer, the layer holds the part above or below it
+// only, as its voxels do: there the sections at the voxel centres within the layer.
+std::vector<double> near_net_section_heights(const std::vector<geometry::Triangle>& design, double zb,
+                                             double layer_height, double bead_height, const geometry::Lattice& lattice);
+
 // The loop (region on its right, as TipKeepOut's) with each convex corner whose design
 // corner lies farther than `bead.corner_reach` from it replaced by a detour: along the
 // incoming side to a little before it, out along its bisector until the design's corner is

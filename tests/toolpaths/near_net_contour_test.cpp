@@ -162,5 +162,24 @@ TEST(NearNetContour, AConvexCornerMovesOutUntilTheBeadReachesTheDesignsCorner) {
   EXPECT_EQ(corners_reaching(loop, {0.6, a, kNoReach, 1.0}), loop);
 }
 
+// A layer follows the section in the middle of the height over which its bead is full
+// width: on a face leaning over the layer, the staircase then straddles the face. Where a
+// flat face lies within the layer (a step), the layer holds the part above or below it, as
+// its voxel centres do, and follows their sections.
+TEST(NearNetSectionHeights, TheMiddleOfTheBeadsFullWidthUnlessAFlatFaceLiesWithinTheLayer) {
+  const geometry::TriangleMesh step = geometry::testing::joined(geometry::testing::box_mesh({0, 0, 0}, {20, 20, 10}),
+                                                       geometry::testing::box_mesh({5, 5, 10}, {15, 15, 20}));
+  // A 0.75 mm bead in 0.6 mm layers is full width up to 0.375 mm: its middle, 0.1875 up.
+  const std::vector<double> plain = near_net_section_heights(step.triangles, 4.0, 0.6, 0.75, kLattice);
+  ASSERT_EQ(plain.size(), 1u);
+  EXPECT_NEAR(plain[0], 4.1875, 1e-12);
+  // A bead full width over the whole layer: the layer's middle.
+  EXPECT_NEAR(near_net_section_heights(step.triangles, 4.0, 0.3, 0.75, kLattice).at(0), 4.15, 1e-12);
+  // The step's top at z = 10 lies within [9.8, 10.4]: the voxel centre 10.25 (above it) only.
+  EXPECT_EQ(near_net_section_heights(step.triangles, 9.8, 0.6, 0.75, kLattice), std::vector<double>{10.25});
+  // A layer that ends on the flat face is not crossed by it.
+  EXPECT_EQ(near_net_section_heights(step.triangles, 9.4, 0.6, 0.75, kLattice).size(), 1u);
+}
+
 }  // namespace
 }  // namespace hybridctl::toolpaths
