@@ -163,4 +163,29 @@ std::vector<Shortfall> find_spills(const PlanningProblem& problem, const AtomDec
   return out;
 }
 
+namespace {
+
+bool excess_near(const AtomMeasures& atom, const geometry::Lattice& lattice, const plan::ExactDeviation& exact) {
+  const plan::ExactPlace& e = exact.excess;
+  if (!e.at || e.mm <= exact.tolerance) return false;
+  const double reach = 2 * lattice.voxel_size;
+  const geometry::Box3 box = lattice.extent(atom.bounding_box);
+  const geometry::Vec3& p = *e.at;
+  return p.x >= box.min.x - reach && p.x <= box.max.x + reach && p.y >= box.min.y - reach &&
+         p.y <= box.max.y + reach && p.z >= box.min.z - reach && p.z <= box.max.z + reach;
+}
+
+}  // namespace
+
+std::vector<Shortfall> spills_beyond_the_grid(std::vector<Shortfall> spills, const std::vector<AtomMeasures>& measures,
+                                              const geometry::Lattice& lattice,
+                                              const std::optional<plan::ExactDeviation>& exact) {
+  if (!exact) return spills;
+  std::erase_if(spills, [&](const Shortfall& s) {
+    const AtomMeasures& m = measures[std::size_t(s.atom)];
+    return s.spill && m.thin_gap && m.voxels_beyond_hull == 0 && !excess_near(m, lattice, *exact);
+  });
+  return spills;
+}
+
 }  // namespace hybridctl::planner

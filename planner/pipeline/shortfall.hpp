@@ -11,12 +11,14 @@
 // atom outside its primitive (a spill): that atom is added to the primitive instead.
 
 #include <cstddef>
+#include <optional>
 #include <utility>
 #include <vector>
 
 #include "geometry/solid.hpp"
 #include "planner/atoms/atoms.hpp"
 #include "planner/pipeline/deposited_faces.hpp"
+#include "plan/deviation.hpp"
 #include "plan/rejection.hpp"
 #include "planner/search/search.hpp"
 
@@ -87,5 +89,15 @@ std::vector<Shortfall> find_skipped_layer_shortfalls(const PlanningProblem& prob
 std::vector<Shortfall> find_spills(const PlanningProblem& problem, const AtomDecomposition& atoms, const Plan& plan,
                                    std::size_t steps, const geometry::Solid& built,
                                    const std::vector<plan::RejectionReason>& reasons);
+
+// The spills that are the deposit's, not the grid's. An atom that must stay empty only to
+// keep a gap open (thin_gap, and none of its voxels beyond the tolerance zone's hull) may
+// be a concave corner's voxels within a voxel of the STL's faces, which a bead laid up to
+// the real faces fills: where `exact` (the candidate's exact verification) finds no
+// excess beyond the tolerance within two voxels of it, the part made is within the
+// tolerance there, and the spill is dropped. Without an exact verification all are kept.
+std::vector<Shortfall> spills_beyond_the_grid(std::vector<Shortfall> spills, const std::vector<AtomMeasures>& measures,
+                                              const geometry::Lattice& lattice,
+                                              const std::optional<plan::ExactDeviation>& exact);
 
 }  // namespace hybridctl::planner

@@ -166,6 +166,36 @@ TEST(Shortfall, ADepositThatLeavesMaterialWhereNoRemovalSparingTheDesignReachesS
   EXPECT_TRUE(find_spills(row.problem, row.atoms, row.plan({2}), 1, voxels(0, 5), {}).empty());
 }
 
+// A spill onto an atom that must stay empty only to keep a gap open, and lies within the
+// tolerance zone's hull, is the grid's where the part made is within the tolerance near it
+// on the STL (a concave corner's voxels, which a bead laid up to the real faces fills); it
+// is the deposit's where exact verification finds excess beyond the tolerance by it, where
+// the atom lies beyond the hull, and where nothing was judged on the STL.
+TEST(Shortfall, ASpillOntoAGapsVoxelsWithinTheHullIsTheGridsWhereTheStlSaysTheCornerIsWithin) {
+  const geometry::Lattice lattice{0.5, {0, 0, 0}};
+  std::vector<AtomMeasures> measures(3);
+  measures[0].thin_gap = true;  // a corner's voxels beside the faces: x, y, z in [0, 1) mm
+  measures[0].bounding_box = {{0, 0, 0}, {2, 2, 2}};
+  measures[1] = measures[0];
+  measures[1].voxels_beyond_hull = 3;  // reaching out beyond the hull
+  measures[2].voxels_beyond_hull = 4;  // beyond the hull, no gap
+  measures[2].bounding_box = measures[0].bounding_box;
+  const std::vector<Shortfall> spills{{0, 0, 1.0, true}, {0, 1, 1.0, true}, {0, 2, 1.0, true}, {1, 0, 1.0, false}};
+  plan::ExactDeviation exact;
+  exact.tolerance = 0.3;
+  exact.excess = {0.39, geometry::Vec3{20, 20, 5}, 1, 100, true, false};  // far from them
+  const std::vector<Shortfall> kept = spills_beyond_the_grid(spills, measures, lattice, exact);
+  EXPECT_EQ(kept, (std::vector<Shortfall>{spills[1], spills[2], spills[3]}));
+  // Excess beyond the tolerance within two voxels of the corner: the deposit's.
+  exact.excess.at = geometry::Vec3{1.9, 0.5, 0.5};
+  EXPECT_EQ(spills_beyond_the_grid(spills, measures, lattice, exact), spills);
+  // Excess there but within the tolerance: the grid's.
+  exact.excess.mm = 0.25;
+  EXPECT_EQ(spills_beyond_the_grid(spills, measures, lattice, exact).size(), 3u);
+  // Not judged on the STL: every spill stands.
+  EXPECT_EQ(spills_beyond_the_grid(spills, measures, lattice, std::nullopt), spills);
+}
+
 // The bundled flanged hub on hybrid-3axis at 1 mm, planned with the test's options (its
 // validation hook stands in for execution).
 PlanningResult plan_flanged_hub(PlanningOptions options) {
