@@ -93,9 +93,10 @@ std::vector<Shortfall> find_spills(const PlanningProblem& problem, const AtomDec
 // The spills that are the deposit's, not the grid's. An atom that must stay empty only to
 // keep a gap open (thin_gap, and none of its voxels beyond the tolerance zone's hull) may
 // be a concave corner's voxels within a voxel of the STL's faces, which a bead laid up to
-// the real faces fills: where `exact` (the candidate's exact verification) finds no
-// excess beyond the tolerance within two voxels of it, the part made is within the
-// tolerance there, and the spill is dropped. Without an exact verification all are kept.
+// the real faces fills: unless the worst excess `exact` (the candidate's exact
+// verification) names lies beyond the tolerance within two voxels of it, the spill is
+// dropped (a place the worst one hides shows once that is mended). Without an exact
+// verification all are kept.
 std::vector<Shortfall> spills_beyond_the_grid(std::vector<Shortfall> spills, const std::vector<AtomMeasures>& measures,
                                               const geometry::Lattice& lattice,
                                               const std::optional<plan::ExactDeviation>& exact);
