@@ -42,7 +42,7 @@ CandidateCheck learn_from_run(const PlanningResult& r, const Plan& plan, const p
   if (shortfalls.empty()) shortfalls = find_skipped_layer_shortfalls(r.problem, r.atoms, plan, executed, built, run.reasons);
   if (shortfalls.empty())
     shortfalls = spills_beyond_the_grid(find_spills(r.problem, r.atoms, plan, executed, built, run.reasons),
-                                        r.measures, r.atoms.lattice(), run.exact);
+                                        r.atoms, r.measures, run.exact);
   CandidateCheck check{std::move(run.reasons), std::move(shortfalls)};
   check.faces = std::move(faces);
   return check;

@@ -163,27 +163,17 @@ std::vector<Shortfall> find_spills(const PlanningProblem& problem, const AtomDec
   return out;
 }
 
-namespace {
-
-bool excess_near(const AtomMeasures& atom, const geometry::Lattice& lattice, const plan::ExactDeviation& exact) {
-  const plan::ExactPlace& e = exact.excess;
-  if (!e.at || e.mm <= exact.tolerance) return false;
-  const double reach = 2 * lattice.voxel_size;
-  const geometry::Box3 box = lattice.extent(atom.bounding_box);
-  const geometry::Vec3& p = *e.at;
-  return p.x >= box.min.x - reach && p.x <= box.max.x + reach && p.y >= box.min.y - reach &&
-         p.y <= box.max.y + reach && p.z >= box.min.z - reach && p.z <= box.max.z + reach;
-}
-
-}  // namespace
-
-std::vector<Shortfall> spills_beyond_the_grid(std::vector<Shortfall> spills, const std::vector<AtomMeasures>& measures,
-                                              const geometry::Lattice& lattice,
+std::vector<Shortfall> spills_beyond_the_grid(std::vector<Shortfall> spills, const AtomDecomposition& atoms,
+                                              const std::vector<AtomMeasures>& measures,
                                               const std::optional<plan::ExactDeviation>& exact) {
   if (!exact) return spills;
+  // The atoms within two voxels of the worst excess, where it is beyond the tolerance.
+  std::vector<char> near_excess(measures.size(), 0);
+  if (exact->excess.at && exact->excess.mm > exact->tolerance)
+    for_each_voxel_near(atoms, *exact->excess.at, [&](Index3 v) { near_excess[std::size_t(atoms.atom_at(v))] = 1; });
   std::erase_if(spills, [&](const Shortfall& s) {
     const AtomMeasures& m = measures[std::size_t(s.atom)];
-    return s.spill && m.thin_gap && m.voxels_beyond_hull == 0 && !excess_near(m, lattice, *exact);
+    return s.spill && m.thin_gap && m.voxels_beyond_hull == 0 && !near_excess[std::size_t(s.atom)];
   });
   return spills;
 }

@@ -97,8 +97,8 @@ std::vector<Shortfall> find_spills(const PlanningProblem& problem, const AtomDec
 // verification) names lies beyond the tolerance within two voxels of it, the spill is
 // dropped (a place the worst one hides shows once that is mended). Without an exact
 // verification all are kept.
-std::vector<Shortfall> spills_beyond_the_grid(std::vector<Shortfall> spills, const std::vector<AtomMeasures>& measures,
-                                              const geometry::Lattice& lattice,
+std::vector<Shortfall> spills_beyond_the_grid(std::vector<Shortfall> spills, const AtomDecomposition& atoms,
+                                              const std::vector<AtomMeasures>& measures,
                                               const std::optional<plan::ExactDeviation>& exact);
 
 }  // namespace hybridctl::planner

@@ -172,28 +172,31 @@ TEST(Shortfall, ADepositThatLeavesMaterialWhereNoRemovalSparingTheDesignReachesS
 // is the deposit's where exact verification finds excess beyond the tolerance by it, where
 // the atom lies beyond the hull, and where nothing was judged on the STL.
 TEST(Shortfall, ASpillOntoAGapsVoxelsWithinTheHullIsTheGridsWhereTheStlSaysTheCornerIsWithin) {
-  const geometry::Lattice lattice{0.5, {0, 0, 0}};
-  std::vector<AtomMeasures> measures(3);
-  measures[0].thin_gap = true;  // a corner's voxels beside the faces: x, y, z in [0, 1) mm
-  measures[0].bounding_box = {{0, 0, 0}, {2, 2, 2}};
-  measures[1] = measures[0];
-  measures[1].voxels_beyond_hull = 3;  // reaching out beyond the hull
-  measures[2].voxels_beyond_hull = 4;  // beyond the hull, no gap
-  measures[2].bounding_box = measures[0].bounding_box;
-  const std::vector<Shortfall> spills{{0, 0, 1.0, true}, {0, 1, 1.0, true}, {0, 2, 1.0, true}, {1, 0, 1.0, false}};
+  // Three atoms along a row of 1 mm voxels: a gap's within the hull (x = 0..2), a gap's
+  // reaching beyond it (x = 2..4), one beyond it and no gap (x = 4..6).
+  const Solid a = voxels(0, 2), b = voxels(2, 4);
+  const AtomDecomposition atoms = AtomDecomposition::recompute(kMm, {{0, 0, 0}, {6, 1, 1}}, {&a, &b});
+  const int corner = atoms.atom_at({0, 0, 0}), reaching = atoms.atom_at({2, 0, 0}), beyond = atoms.atom_at({4, 0, 0});
+  std::vector<AtomMeasures> measures(std::size_t(atoms.atom_count()));
+  measures[std::size_t(corner)].thin_gap = true;
+  measures[std::size_t(reaching)].thin_gap = true;
+  measures[std::size_t(reaching)].voxels_beyond_hull = 1;
+  measures[std::size_t(beyond)].voxels_beyond_hull = 2;
+  const std::vector<Shortfall> spills{
+      {0, corner, 2.0, true}, {0, reaching, 2.0, true}, {0, beyond, 2.0, true}, {1, corner, 2.0, false}};
   plan::ExactDeviation exact;
   exact.tolerance = 0.3;
-  exact.excess = {0.39, geometry::Vec3{20, 20, 5}, 1, 100, true, false};  // far from them
-  const std::vector<Shortfall> kept = spills_beyond_the_grid(spills, measures, lattice, exact);
-  EXPECT_EQ(kept, (std::vector<Shortfall>{spills[1], spills[2], spills[3]}));
-  // Excess beyond the tolerance within two voxels of the corner: the deposit's.
-  exact.excess.at = geometry::Vec3{1.9, 0.5, 0.5};
-  EXPECT_EQ(spills_beyond_the_grid(spills, measures, lattice, exact), spills);
+  exact.excess = {0.39, geometry::Vec3{5.5, 0.5, 0.5}, 1, 100, true, false};  // three voxels from the corner's
+  EXPECT_EQ(spills_beyond_the_grid(spills, atoms, measures, exact),
+            (std::vector<Shortfall>{spills[1], spills[2], spills[3]}));
+  // Excess beyond the tolerance within two voxels of the corner's atom: the deposit's.
+  exact.excess.at = geometry::Vec3{3.5, 0.5, 0.5};
+  EXPECT_EQ(spills_beyond_the_grid(spills, atoms, measures, exact), spills);
   // Excess there but within the tolerance: the grid's.
   exact.excess.mm = 0.25;
-  EXPECT_EQ(spills_beyond_the_grid(spills, measures, lattice, exact).size(), 3u);
+  EXPECT_EQ(spills_beyond_the_grid(spills, atoms, measures, exact).size(), 3u);
   // Not judged on the STL: every spill stands.
-  EXPECT_EQ(spills_beyond_the_grid(spills, measures, lattice, std::nullopt), spills);
+  EXPECT_EQ(spills_beyond_the_grid(spills, atoms, measures, std::nullopt), spills);
 }
 
 // The bundled flanged hub on hybrid-3axis at 1 mm, planned with the test's options (its
