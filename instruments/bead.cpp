@@ -22,6 +22,13 @@ double bead_half_width_at(const Bead& bead, double dz) {
   return r * std::sqrt(std::max(0.0, 1 - u * u));
 }
 
+double bead_wall_scallop(const Bead& bead, double layer_height) {
+  const double widest = bead_half_width_at(bead, 0);
+  // Narrowest just under the next layer's bottom (narrowing all the way up).
+  if (!(layer_height > 0) || layer_height > bead.height) return widest;
+  return widest - bead_half_width_at(bead, layer_height);
+}
+
 double bead_top_dip(const Bead& bead, double spacing) {
   if (bead.shape != config::BeadShape::Ellipsoid || !(bead.width > 0)) return 0;
   const double u = std::min(1.0, spacing / bead.width);

@@ -42,6 +42,12 @@ Bead bead_of(const config::AdditiveHead& head);
 // sideways, and no farther.
 double bead_half_width_at(const Bead& bead, double dz);
 
+// How far (mm) a wall of beads laid `layer_height` apart stands in between its layers from
+// where it stands out, as the material simulation lays them: each bead is full width up to
+// its middle and narrows above it, under the next layer's bottom. A cylinder's wall is
+// flat (0) unless the layers stand apart (then its whole half-width).
+double bead_wall_scallop(const Bead& bead, double layer_height);
+
 // How far under the crests (mm) two tracks laid side by side `spacing` apart meet on top:
 // an ellipsoid track's top is the upper half of its ellipse, a cylinder's is flat (0).
 double bead_top_dip(const Bead& bead, double spacing);

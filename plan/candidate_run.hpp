@@ -10,10 +10,12 @@
 #include <string>
 #include <vector>
 
+#include "geometry/mesh.hpp"
 #include "geometry/solid.hpp"
 #include "plan/deviation.hpp"
 #include "plan/plan_file.hpp"
 #include "plan/rejection.hpp"
+#include "plan/unreached_corner.hpp"
 
 namespace hybridctl::plan {
 
@@ -54,11 +56,18 @@ using CandidateExecutor = std::function<CandidateRun(const PlanFile& file, const
 using KnownRejection =
     std::function<std::optional<std::vector<RejectionReason>>(const PlanFile& file, const PlanFilePlan& candidate)>;
 
+// The stretches of the design's vertical inside edges no cutter of the machine comes
+// within `reach` (mm) of, at least `min_stretch` mm long (toolpaths/corner_reach.hpp).
+using CornerFinder =
+    std::function<std::vector<UnreachedCorner>(const geometry::TriangleMesh& design, double reach, double min_stretch)>;
+
 // An executor and what it already knows, asked first so that a candidate known to fail is
-// passed over without being executed or counted as a rejection.
+// passed over without being executed or counted as a rejection; and what the machine's
+// cutters cannot reach, asked before the search (none: not asked).
 struct CandidateValidator {
   CandidateExecutor execute;
   KnownRejection known;
+  CornerFinder corners;
 };
 
 }  // namespace hybridctl::plan

@@ -11,6 +11,7 @@
 #include "common/number_text.hpp"
 #include "gcode/check.hpp"
 #include "gcode/post.hpp"
+#include "toolpaths/corner_reach.hpp"
 
 namespace hybridctl::validation {
 namespace {
@@ -121,6 +122,17 @@ std::vector<double> action_minutes(const Execution& run, const config::Machine& 
     minutes.push_back((time.motion + time.dwell) / 60.0);
   }
   return minutes;
+}
+
+// The inside corners no cutter of `machine` reaches (toolpaths/corner_reach.hpp), on the
+// design's own triangles.
+plan::CornerFinder corner_finder(const config::Machine& machine) {
+  return [&machine](const geometry::TriangleMesh& design, double reach, double min_stretch) {
+    toolpaths::CornerReachOptions o;
+    o.reach = reach;
+    o.min_stretch = min_stretch;
+    return toolpaths::corners_no_cutter_reaches(geometry::clean_mesh(design).triangles, machine, o);
+  };
 }
 
 }  // namespace
@@ -243,7 +255,7 @@ plan::CandidateValidator plan_validator(const config::Machine& machine, Executio
       return unwritable;
     }
   };
-  return {execute, known};
+  return {execute, known, corner_finder(machine)};
 }
 
 }  // namespace hybridctl::validation

@@ -20,7 +20,8 @@ namespace hybridctl::validation {
 
 // The executor, and what it knows without executing: a candidate that begins with the
 // actions a rejected one failed in, that repeats a failure against the STL, or (past a few
-// such failures and none passing) that has no primitive those did not. It keeps `machine`
+// such failures and none passing) that has no primitive those did not; and the inside
+// corners of a design no cutter of the machine reaches. It keeps `machine`
 // by reference (it must outlive planning). Candidates resume from the prefixes `cache`
 // holds (one is made when none is given; pass one to read its stats); it must serve this
 // executor alone, on one plan file's grid and primitives.

@@ -89,6 +89,7 @@ void validate_by_execution(PlanningOptions& options, plan::CandidateValidator va
     }
     return learn_from_run(r, plan, *state->file, std::move(run), state->core);
   };
+  options.corners = state->validator.corners;
   options.toolpath_minutes = [state](const Plan& plan) {
     const State::Proven* p = state->proven_of(plan);
     return p ? p->action_minutes : std::vector<double>{};

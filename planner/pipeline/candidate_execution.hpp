@@ -17,6 +17,7 @@ plan::PlanFilePlan candidate_plan(const PlanningResult& result, const Plan& plan
 
 // Sets options.validate from `validator.execute`, options.known_failure from
 // `validator.known` (candidates it would turn down unexecuted are passed over uncounted),
+// options.corners from `validator.corners`,
 // and options.toolpath_minutes, cycle_time and exact_deviation to what it gave the plans it
 // proved (the times rank the offered plans where the estimate is far off, docs/costs.md).
 // The planning result is turned into a plan file (to_plan_file, named `machine_name`)

@@ -369,6 +369,15 @@ json plans_json(const PlanningResult& r) {
   return plans;
 }
 
+// The inside corners a refusal rests on (plan-format.md, "Verdict").
+json corners_json(const PlanningResult& r) {
+  json corners = json::array();
+  for (const plan::UnreachedCorner& c : r.unreached_corners)
+    corners.push_back({{"from", vec(c.from)}, {"to", vec(c.to)}, {"air_angle_deg", c.air_angle},
+                       {"nearest_mm", c.nearest}, {"nearest_by", c.nearest_by}});
+  return corners;
+}
+
 }  // namespace
 
 std::string plan_json(const PlanningResult& r, const ReportSources& src, const std::filesystem::path& directory) {
@@ -445,7 +454,8 @@ std::string plan_json(const PlanningResult& r, const ReportSources& src, const s
                     {"modality", modality_name(r.verdict.modality)},
                     {"summary", r.verdict.summary},
                     {"in_shop_words", r.in_shop_words},
-                    {"violations", violations}};
+                    {"violations", violations},
+                    {"unreached_corners", corners_json(r)}};
   json unsplit = json::array();
   for (const FineGraining::Unsplit& u : r.fine_graining.unsplit) unsplit.push_back({{"atom", u.atom}, {"why", u.why}});
   doc["fine_graining"] = {{"rounds", r.fine_graining.rounds},

@@ -28,6 +28,7 @@
 #include "planner/pipeline/memory_estimate.hpp"
 #include "planner/pipeline/search_phase.hpp"
 #include "planner/pipeline/shop_words.hpp"
+#include "planner/pipeline/unreached_corners.hpp"
 #include "planner/primitives/repair.hpp"
 #include "planner/search/steps.hpp"
 
@@ -334,6 +335,14 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
     if (r.core_proof.outcome == CoreProof::Outcome::Proven) r.verdict = core_verdict(r.problem, r.core_proof, r.measures, r.lattice);
     else r.stock_starts = prove_stock_starts(r.problem, quick_proof_limits());
     clock.lap("proof");
+  }
+  // After the proofs, which say more of what they find (a closed space, an overhang), and
+  // before the search, which cannot see what lies within a voxel.
+  if (r.verdict.manufacturable() && options.corners) {
+    const WallsAsDeposited walls = walls_as_deposited(machine, r.tolerance);
+    r.unreached_corners = corners_no_instrument_makes(r, walls, options.corners);
+    if (!r.unreached_corners.empty()) r.verdict = corner_refusal(r.unreached_corners, walls, r.tolerance);
+    clock.lap("corners");
   }
   if (r.verdict.manufacturable()) search_phase(top_k, options, progress, r, validation_seconds);
   settle_outcome(r);

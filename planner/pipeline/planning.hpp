@@ -94,6 +94,11 @@ struct PlanningOptions {
   // (validation records it as it proves plans; none: not verified exactly).
   std::function<std::optional<plan::ExactDeviation>(const Plan&)> exact_deviation;
   std::int64_t max_rejected = 200;
+  // Before the search: the design's inside corners no cutter of the machine reaches
+  // (validation sets it: plan::CandidateValidator::corners). Where no head lays walls
+  // within the tolerance either, the part is refused over them
+  // (planner/pipeline/unreached_corners.hpp); unset: not asked.
+  plan::CornerFinder corners;
 };
 
 // A candidate plan that validation turned down, with its reasons.
@@ -117,6 +122,8 @@ struct PlanningResult {
   std::vector<AtomMeasures> measures;
   PlanningProblem problem;
   Verdict verdict;
+  // The inside corners a refusal rests on, when it rests on them (unreached_corners.hpp).
+  std::vector<plan::UnreachedCorner> unreached_corners;
   // A refusal's located regions in a shop's words (planner/pipeline/shop_words.hpp): its
   // air, and design no head builds over an overhang; empty for a part with plans.
   std::vector<std::string> in_shop_words;

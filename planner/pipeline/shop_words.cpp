@@ -10,6 +10,7 @@
 #include "common/number_text.hpp"
 #include "instruments/elements.hpp"
 #include "instruments/support_rule.hpp"
+#include "planner/pipeline/unreached_corners.hpp"
 #include "planner/primitives/support.hpp"
 
 namespace hybridctl::planner {
@@ -523,6 +524,17 @@ std::optional<Overhang> overhang_of(const PlanningResult& r, const ViolatingAtom
 std::vector<std::string> refusal_in_shop_words(const config::Machine& machine, const PlanningResult& r, std::size_t limit) {
   std::vector<std::string> out;
   if (r.verdict.manufacturable() && !r.plans.empty()) return out;
+  if (!r.unreached_corners.empty()) {
+    // The corners, as many as leave a line for the rest and one for the heads.
+    const std::size_t n = r.unreached_corners.size(), shown = std::min(n, limit > 2 ? limit - 2 : 1);
+    for (std::size_t i = 0; i < shown; ++i) out.push_back(corner_in_words(r.unreached_corners[i], r.tolerance));
+    if (n > shown)
+      out.push_back("and " + std::to_string(n - shown) + " more such corner" + (n - shown == 1 ? "" : "s") +
+                    " (plan.json's verdict.unreached_corners)");
+    out.push_back("and no head lays a wall within " + trimmed_number(r.tolerance, 3) +
+                  " mm as deposited: " + walls_as_deposited(machine, r.tolerance).said);
+    return out;
+  }
   // Closed spaces are said once, the regions of air they are split into added up.
   std::size_t closed_line = 0;
   int closed = 0;

@@ -207,6 +207,30 @@ TEST_F(Cli, TheOverhangOnTheBAxisMachineIsProvenImpossibleBeforeAnySearch) {
   EXPECT_NE(json.find("\"violations\": [\n"), std::string::npos);
 }
 
+// The bladed disc's blades meet its hub in inside corners of 93.7 degrees. On the B-axis
+// machine at its own 0.3 mm, no cutter gets within the tolerance of the eight beside the
+// blades off the axes (the 4 mm cutter from above leaves 0.57 mm; the ones along X and Y
+// look across them), and its powder head lays walls within 0.31 mm at best. Every
+// candidate came off the machine 0.59 mm out there, and the search ran to its limit
+// (UNDECIDED, 112 s); the part is refused before the search, the corners named.
+TEST_F(Cli, TheBladedDiscIsRefusedOnTheBAxisMachineForTheInsideCornersAtItsBladesRoots) {
+  const Outcome r = run({"plan", kParts + "bladed-disc.stl", "--machine", kBAxisMachine, "-o", (dir_ / "plan").string()});
+  EXPECT_EQ(r.exit_code, 4) << r.err << r.out;
+  EXPECT_NE(r.out.find("\nin words    the inside corner at ("), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("and 6 more such corners (plan.json's verdict.unreached_corners)"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("and no head lays a wall within 0.3 mm as deposited: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("ded within 0.31 mm (its accuracy 0.25 mm and half its layers' 0.12 mm scallop)"),
+            std::string::npos)
+      << r.out;
+  EXPECT_EQ(r.out.find("rejected"), std::string::npos) << r.out;
+  const std::string json = slurp(dir_ / "plan" / "plan.json");
+  std::size_t corners = 0;
+  for (std::size_t at = json.find("\"air_angle_deg\""); at != std::string::npos; at = json.find("\"air_angle_deg\"", at + 1))
+    ++corners;
+  EXPECT_EQ(corners, 8u);
+  EXPECT_NE(json.find("\"outcome\": \"not-manufacturable\""), std::string::npos);
+}
+
 // A refusal a shop can read: the lidded channel's closed space in shop words, and the
 // proof in atoms and regions (the planner's language) in plan.json and behind --verbose.
 TEST_F(Cli, ARefusalIsSaidInShopWordsWithItsProofInAtomsBehindVerbose) {

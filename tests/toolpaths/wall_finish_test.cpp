@@ -20,6 +20,8 @@
 #include <numbers>
 #include <vector>
 
+#include "test_meshes.hpp"
+
 namespace hybridctl::toolpaths {
 namespace {
 
@@ -31,33 +33,6 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 const WallFinishOptions kOptions{};  // chord 0.001, clearance 0.0002
 // The integer grid (10 nm) and the offset's own rounding.
 constexpr double kRounding = 2e-5;
-
-// A prism over a polygon that is star-shaped from its first vertex, z0..z1.
-Mesh prism(const std::vector<Point2>& poly, double z0, double z1) {
-  Mesh m;
-  const std::size_t n = poly.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    const Point2 a = poly[i], b = poly[(i + 1) % n];
-    m.push_back({Vec3{a.x, a.y, z0}, Vec3{b.x, b.y, z0}, Vec3{b.x, b.y, z1}});
-    m.push_back({Vec3{a.x, a.y, z0}, Vec3{b.x, b.y, z1}, Vec3{a.x, a.y, z1}});
-  }
-  for (std::size_t i = 1; i + 1 < n; ++i) {
-    m.push_back({Vec3{poly[0].x, poly[0].y, z0}, Vec3{poly[i + 1].x, poly[i + 1].y, z0}, Vec3{poly[i].x, poly[i].y, z0}});
-    m.push_back({Vec3{poly[0].x, poly[0].y, z1}, Vec3{poly[i].x, poly[i].y, z1}, Vec3{poly[i + 1].x, poly[i + 1].y, z1}});
-  }
-  return m;
-}
-
-std::vector<Point2> rectangle(double x0, double y0, double x1, double y1) { return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}; }
-
-std::vector<Point2> regular(int n, double radius, Point2 c = {0, 0}) {
-  std::vector<Point2> p;
-  for (int i = 0; i < n; ++i) {
-    const double a = 2 * std::numbers::pi * i / n;
-    p.push_back({c.x + radius * std::cos(a), c.y + radius * std::sin(a)});
-  }
-  return p;
-}
 
 // A solid of revolution about the Z axis through `c`: the profile (radius, z) from the axis
 // at the bottom to the axis at the top, turned in n steps (the STL's n-gons).
