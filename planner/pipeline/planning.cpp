@@ -338,8 +338,8 @@ PlanningResult plan_part(const geometry::TriangleMesh& part, const std::string& 
   }
   // After the proofs, which say more of what they find (a closed space, an overhang), and
   // before the search, which cannot see what lies within a voxel.
-  if (r.verdict.manufacturable() && options.corners) {
-    const WallsAsDeposited walls = walls_as_deposited(machine, r.tolerance);
+  if (const WallsAsDeposited walls = walls_as_deposited(machine, r.tolerance);
+      r.verdict.manufacturable() && options.corners && !walls.within) {
     r.unreached_corners = corners_no_instrument_makes(r, walls, options.corners);
     if (!r.unreached_corners.empty()) r.verdict = corner_refusal(r.unreached_corners, walls, r.tolerance);
     clock.lap("corners");
