@@ -523,6 +523,28 @@ std::vector<Trial> try_run(const std::vector<Sighting>& run, const Paths& around
   return trials;
 }
 
+// The runs of heights one step apart that `trials` found unreached at `at`, each at least
+// options.min_stretch long, appended to `out`.
+void named_stretches(P2 at, const std::vector<Trial>& trials, const CornerReachOptions& o,
+                     std::vector<UnreachedCorner>& out) {
+  for (std::size_t i = 0; i < trials.size();) {
+    if (!trials[i].unreached) {
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    double nearest = trials[i].nearest;
+    std::string by = trials[i].by;
+    while (j + 1 < trials.size() && trials[j + 1].unreached && trials[j + 1].z - trials[j].z < o.step * 1.5) {
+      ++j;
+      if (trials[j].nearest < nearest) nearest = trials[j].nearest, by = trials[j].by;
+    }
+    if (trials[j].z - trials[i].z >= o.min_stretch - 1e-9)
+      out.push_back({{at.x, at.y, trials[i].z}, {at.x, at.y, trials[j].z}, trials[i].air_angle, nearest, by});
+    i = j + 1;
+  }
+}
+
 }  // namespace
 
 std::vector<UnreachedCorner> corners_no_cutter_reaches(const std::vector<Triangle>& design, const config::Machine& machine,
@@ -550,7 +572,6 @@ std::vector<UnreachedCorner> corners_no_cutter_reaches(const std::vector<Triangl
     if (std::abs(nz) > 1e-12) sloped.push_back({lo, hi, {t[0].x, t[0].y}, {t[1].x, t[1].y}, {t[2].x, t[2].y}});
   }
   using Key = std::pair<ClipperLib::cInt, ClipperLib::cInt>;
-  std::map<Key, std::vector<Trial>> trials;
   // Where each corner is seen, and the sections round it (a prism's corner has the same
   // section at every height), then its trials run by run of heights with one section.
   std::map<Key, std::vector<Sighting>> sightings;
@@ -569,35 +590,19 @@ std::vector<UnreachedCorner> corners_no_cutter_reaches(const std::vector<Triangl
       sightings[key].push_back({z, prism_round(c.at, z, o.max_window, sloped), c.air_angle, c.at, seen.size() - 1});
     }
   }
-  for (const auto& [key, list] : sightings)
+  std::vector<UnreachedCorner> out;
+  for (const auto& [key, list] : sightings) {
+    // Enough named: a part with many such corners (a gear's roots) is not tried whole.
+    if (out.size() >= o.max_corners) break;
+    std::vector<Trial> trials;
     for (std::size_t i = 0; i < list.size();) {
       std::size_t j = i;
       while (j < list.size() && list[j].around == list[i].around) ++j;
       const std::vector<Sighting> run(list.begin() + std::ptrdiff_t(i), list.begin() + std::ptrdiff_t(j));
-      for (Trial& t : try_run(run, arounds[key][list[i].around], approaches, o)) trials[key].push_back(std::move(t));
+      for (Trial& t : try_run(run, arounds[key][list[i].around], approaches, o)) trials.push_back(std::move(t));
       i = j;
     }
-
-  std::vector<UnreachedCorner> out;
-  for (auto& [key, list] : trials) {
-    const P2 at{to_mm(key.first), to_mm(key.second)};
-    for (std::size_t i = 0; i < list.size();) {
-      if (!list[i].unreached) {
-        ++i;
-        continue;
-      }
-      std::size_t j = i;
-      double nearest = list[i].nearest;
-      std::string by = list[i].by;
-      // A run of heights one step apart, each unreached.
-      while (j + 1 < list.size() && list[j + 1].unreached && list[j + 1].z - list[j].z < o.step * 1.5) {
-        ++j;
-        if (list[j].nearest < nearest) nearest = list[j].nearest, by = list[j].by;
-      }
-      if (list[j].z - list[i].z >= o.min_stretch - 1e-9)
-        out.push_back({{at.x, at.y, list[i].z}, {at.x, at.y, list[j].z}, list[i].air_angle, nearest, by});
-      i = j + 1;
-    }
+    named_stretches(P2{to_mm(key.first), to_mm(key.second)}, trials, o, out);
   }
   std::sort(out.begin(), out.end(), [](const UnreachedCorner& a, const UnreachedCorner& b) {
     if (a.from.z != b.from.z) return a.from.z < b.from.z;

@@ -42,12 +42,14 @@ struct CornerReachOptions {
   double max_air_angle = 165;     // degrees: flatter corners (a faceted bore) are not tried
   double max_window = 25;         // mm: how far round a corner the design is taken in
   double min_stretch = 0;         // mm: shorter unreached stretches are not named
+  std::size_t max_corners = 16;   // corners are tried until this many stretches are named
   double chord_tolerance = 0.001; // mm: the polygons' chords against their arcs
 };
 
 // The stretches of `design`'s vertical inside edges where no tool of `machine`, from the
 // approach of any of its setups, comes within options.reach, at least options.min_stretch
-// long, lowest edge first. `design` is a closed mesh (geometry::clean_mesh), part frame.
+// long, lowest edge first: corners are tried in the order of their places until
+// options.max_corners stretches are named, the others left untried. `design` is a closed mesh (geometry::clean_mesh), part frame.
 std::vector<plan::UnreachedCorner> corners_no_cutter_reaches(const std::vector<geometry::Triangle>& design,
                                                              const config::Machine& machine,
                                                              const CornerReachOptions& options);

@@ -122,5 +122,14 @@ TEST(CornerReach, TheBladedDiscsBladesOffTheAxesMeetTheHubInCornersNoCutterOfThe
   }
 }
 
+// A refusal needs one corner: a part with many is tried only until the cap is named.
+TEST(CornerReach, CornersAreTriedOnlyUntilAsManyAsAskedAreNamed) {
+  const geometry::TriangleMesh disc = geometry::read_stl(HYBRIDCTL_SOURCE_DIR "/examples/parts/bladed-disc.stl");
+  const config::Machine machine = config::load_machine(HYBRIDCTL_SOURCE_DIR "/examples/machines/multitask-b-axis.yaml");
+  CornerReachOptions o = at_tolerance(0.3);
+  o.max_corners = 2;
+  EXPECT_EQ(corners_no_cutter_reaches(geometry::clean_mesh(disc).triangles, machine, o).size(), 2u);
+}
+
 }  // namespace
 }  // namespace hybridctl::toolpaths
