@@ -38,7 +38,6 @@ struct P2 {
 // A tool as it stands in the plane: its radii and lengths along its axis, mm.
 struct ToolShape {
   std::string name;  // "T4 (4 mm flat detail)"
-  config::ToolType type = config::ToolType::Flat;
   double r = 0, corner = 0, flute = 0;
   double shank_r = 0, shank_length = 0, holder_r = 0, holder_length = 0;
 };
@@ -47,7 +46,6 @@ ToolShape shape_of(const config::CuttingTool& in) {
   const config::CuttingTool t = instruments::with_defaults(in);
   ToolShape s;
   s.name = "T" + std::to_string(t.number) + " (" + t.name + ")";
-  s.type = t.type;
   s.r = t.diameter / 2;
   s.corner = t.type == config::ToolType::Ball ? s.r : t.type == config::ToolType::Bull ? t.corner_radius : 0.0;
   s.flute = t.flute_length;
